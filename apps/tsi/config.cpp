@@ -1,0 +1,202 @@
+#include "config.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "tsi/error.hpp"
+
+namespace tsi::app {
+namespace {
+
+const std::vector<std::string> sections = {"model",     "reformulation", "scheme", "time",
+                                           "reference", "output",        "plugins"};
+
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+const Json& section_object(const Json& raw, const std::string& key, const Json& fallback) {
+  if (!raw.contains(key)) return fallback;
+  const Json& s = raw.at(key);
+  if (!s.is_object()) throw ConfigError(key, "got " + s.dump() + ", expected an object");
+  return s;
+}
+
+std::string name_of(const Json& section, const std::string& key, const std::string& fallback) {
+  if (!section.contains("name")) {
+    if (fallback.empty()) throw ConfigError(key + ".name", "missing; it names the " + key + " to use");
+    return fallback;
+  }
+  const Json& n = section.at("name");
+  if (!n.is_string()) throw ConfigError(key + ".name", "got " + n.dump() + ", expected a string");
+  return n.get<std::string>();
+}
+
+Json with_name(const std::string& name, const Json& params) {
+  Json out = {{"name", name}};
+  out.update(params);
+  return out;
+}
+
+const ParamSchema& time_schema() {
+  static const ParamSchema schema = {
+      number_param("h", 0.125, "time step").range(0.0, std::numeric_limits<double>::infinity(), true),
+      number_param("t_end", 1.0, "final time").range(0.0, std::numeric_limits<double>::infinity())};
+  return schema;
+}
+
+const ParamSchema& reference_schema() {
+  static const ParamSchema schema = {
+      string_param("scheme", "rk78", "the reference solver"),
+      string_param("reformulation", "filtered", "the problem the reference solver integrates"),
+      number_param("tol", 1e-13, "the reference solver's tolerance").range(1e-16, 1e-1),
+      number_param("h", nullptr, "step of a non-adaptive reference solver; default: t_end")
+          .range(0.0, std::numeric_limits<double>::infinity(), true)};
+  return schema;
+}
+
+const ParamSchema& output_schema() {
+  static const ParamSchema schema = {
+      integer_param("every", 1, "write a row of invariants.csv every this many steps")
+          .check([](const Json& v) { return v.get<long>() >= 1; }, "a positive integer")};
+  return schema;
+}
+
+}  // namespace
+
+Json load_config_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path, "cannot open the config file (missing or unreadable)");
+  try {
+    return Json::parse(in, nullptr, true, /*ignore_comments=*/true);
+  } catch (const Json::parse_error& e) {
+    throw ConfigError(path, std::string("malformed JSON: ") + e.what());
+  }
+}
+
+void apply_override(Json& config, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw ConfigError("--set", "got \"" + assignment + "\", expected key.path=value");
+  const std::string path = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  Json value;
+  try {
+    value = Json::parse(text);
+  } catch (const Json::parse_error&) {
+    value = text;  // a bare word is a string
+  }
+  std::vector<std::string> keys;
+  std::stringstream ss(path);
+  for (std::string key; std::getline(ss, key, '.');) {
+    if (key.empty()) throw ConfigError("--set " + path, "empty component in the key path");
+    keys.push_back(key);
+  }
+  if (std::find(sections.begin(), sections.end(), keys.front()) == sections.end())
+    throw ConfigError("--set " + path, "unknown section \"" + keys.front() +
+                                           "\"; valid sections are: " + join(sections));
+  Json* node = &config;
+  for (size_t i = 0; i + 1 < keys.size(); ++i) {
+    if (!node->is_object())
+      throw ConfigError("--set " + path, "cannot descend into a value that is not an object");
+    node = &(*node)[keys[i]];
+    if (node->is_null()) *node = Json::object();
+  }
+  if (!node->is_object()) throw ConfigError("--set " + path, "the parent of the key is not an object");
+  (*node)[keys.back()] = value;
+}
+
+Json without_name(const Json& section) {
+  Json out = section;
+  out.erase("name");
+  return out;
+}
+
+Json resolve_run_config(const Json& raw, const Registry& registry) {
+  if (!raw.is_object()) throw ConfigError("config", "got " + raw.dump() + ", expected a JSON object");
+  for (const auto& [key, value] : raw.items())
+    if (std::find(sections.begin(), sections.end(), key) == sections.end())
+      throw ConfigError(key, "unknown section; valid sections are: " + join(sections));
+
+  const Json empty = Json::object();
+  Json out;
+
+  const Json& model = section_object(raw, "model", empty);
+  const ModelEntry& model_entry = registry.model(name_of(model, "model", ""));
+  out["model"] = with_name(model_entry.info.name,
+                           resolve_params(model_entry.info.params, without_name(model), "model"));
+
+  const Json& scheme = section_object(raw, "scheme", empty);
+  const SchemeEntry& scheme_entry = registry.scheme(name_of(scheme, "scheme", "se1"));
+  out["scheme"] = with_name(scheme_entry.info.name,
+                            resolve_params(scheme_entry.info.params, without_name(scheme), "scheme"));
+
+  const Json& reformulation = section_object(raw, "reformulation", empty);
+  const auto& supported = scheme_entry.traits.reformulations;
+  const std::string default_reformulation =
+      std::find(supported.begin(), supported.end(), "two-scale") != supported.end() || supported.empty()
+          ? "two-scale"
+          : supported.front();
+  const ReformulationEntry& reformulation_entry =
+      registry.reformulation(name_of(reformulation, "reformulation", default_reformulation));
+  registry.check_compatible(scheme_entry, reformulation_entry);
+  Json rparams = resolve_params(reformulation_entry.info.params, without_name(reformulation),
+                                "reformulation");
+  if (rparams.contains("n_tau") && rparams["n_tau"].is_null()) rparams["n_tau"] = model_entry.default_n_tau;
+  if (rparams.contains("initial_data_order") && rparams["initial_data_order"].is_null())
+    rparams["initial_data_order"] = std::max(1, scheme_entry.traits.initial_data_order);
+  out["reformulation"] = with_name(reformulation_entry.info.name, rparams);
+
+  out["time"] = resolve_params(time_schema(), section_object(raw, "time", empty), "time");
+  step_count(out);  // t_end must be a whole number of steps
+
+  if (raw.contains("reference") && !raw.at("reference").is_null()) {
+    Json ref = resolve_params(reference_schema(), section_object(raw, "reference", empty), "reference");
+    const SchemeEntry& ref_scheme = registry.scheme(ref["scheme"], "reference.scheme");
+    const ReformulationEntry& ref_reform =
+        registry.reformulation(ref["reformulation"], "reference.reformulation");
+    try {
+      registry.check_compatible(ref_scheme, ref_reform);
+    } catch (const ConfigError& e) {
+      throw ConfigError("reference.reformulation", e.what());
+    }
+    ref["scheme"] = ref_scheme.info.name;
+    ref["reformulation"] = ref_reform.info.name;
+    if (!ref_scheme.traits.adaptive && ref["h"].is_null())
+      throw ConfigError("reference.h", "the reference scheme \"" + ref_scheme.info.name +
+                                           "\" is not adaptive: give its step h");
+    out["reference"] = ref;
+  }
+
+  out["output"] = resolve_params(output_schema(), section_object(raw, "output", empty), "output");
+
+  out["plugins"] = Json::array();
+  if (raw.contains("plugins")) {
+    const Json& plugins = raw.at("plugins");
+    if (!plugins.is_array()) throw ConfigError("plugins", "got " + plugins.dump() + ", expected a list of file names");
+    for (const auto& p : plugins) {
+      if (!p.is_string()) throw ConfigError("plugins", "got " + p.dump() + ", expected a file name");
+      out["plugins"].push_back(p);
+    }
+  }
+  return out;
+}
+
+long step_count(const Json& resolved) {
+  const double h = resolved.at("time").at("h"), t_end = resolved.at("time").at("t_end");
+  const double steps = t_end / h;
+  const double whole = std::round(steps);
+  if (std::abs(steps - whole) > 1e-9 * std::max(1.0, steps))
+    throw ConfigError("time.h", fmt::format("t_end = {} is not a whole number of steps of h = {} "
+                                            "({:.6g} steps); choose h = t_end / n",
+                                            t_end, h, steps));
+  if (whole > 1e12) throw ConfigError("time.h", fmt::format("t_end / h = {:.3g} steps is too many", steps));
+  return static_cast<long>(whole);
+}
+
+}  // namespace tsi::app

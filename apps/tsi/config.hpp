@@ -1,0 +1,26 @@
+#pragma once
+#include <string>
+
+#include "tsi/params.hpp"
+#include "tsi/registry.hpp"
+
+namespace tsi::app {
+
+/// Reads a JSON config file; a missing or malformed file is a ConfigError naming it.
+Json load_config_file(const std::string& path);
+
+/// Applies one `--set key.path=value` (value parsed as JSON, else taken as a string).
+/// A path through a non-object, or an unknown section, is a ConfigError naming the path.
+void apply_override(Json& config, const std::string& assignment);
+
+/// Validates a run config against the registry and fills every default: the result names
+/// every parameter that the run uses (canonical names, model's n_tau, scheme's data order).
+Json resolve_run_config(const Json& raw, const Registry& registry);
+
+/// Number of steps t_end / h (t_end must be a whole number of steps).
+long step_count(const Json& resolved);
+
+/// The section of an object config without its "name" key.
+Json without_name(const Json& section);
+
+}  // namespace tsi::app

@@ -1,0 +1,100 @@
+#include "list_command.hpp"
+
+#include <fmt/format.h>
+
+#include "tsi/error.hpp"
+
+namespace tsi::app {
+namespace {
+
+Json params_json(const ParamSchema& schema) {
+  Json out = Json::array();
+  for (const auto& p : schema)
+    out.push_back({{"name", p.name},
+                   {"type", describe(p.type)},
+                   {"default", p.default_value},
+                   {"description", p.description},
+                   {"expected", p.expected}});
+  return out;
+}
+
+Json info_json(const EntryInfo& info) {
+  return {{"name", info.name},
+          {"aliases", info.aliases},
+          {"summary", info.summary},
+          {"provider", info.provider},
+          {"params", params_json(info.params)}};
+}
+
+void check_what(const std::string& what) {
+  if (!what.empty() && what != "models" && what != "reformulations" && what != "schemes")
+    throw ConfigError("list", "got \"" + what + "\", expected models, reformulations or schemes");
+}
+
+}  // namespace
+
+Json list_json(const Registry& registry, const std::string& what) {
+  check_what(what);
+  Json out = Json::object();
+  if (what.empty() || what == "models") {
+    out["models"] = Json::array();
+    for (const auto* e : registry.models()) {
+      Json j = info_json(e->info);
+      j["default_n_tau"] = e->default_n_tau;
+      out["models"].push_back(j);
+    }
+  }
+  if (what.empty() || what == "reformulations") {
+    out["reformulations"] = Json::array();
+    for (const auto* e : registry.reformulations()) out["reformulations"].push_back(info_json(e->info));
+  }
+  if (what.empty() || what == "schemes") {
+    out["schemes"] = Json::array();
+    for (const auto* e : registry.schemes()) {
+      Json j = info_json(e->info);
+      const auto& t = e->traits;
+      j["traits"] = {{"order", t.order},         {"symmetric", t.symmetric},
+                     {"implicit", t.implicit},   {"multistep", t.multistep},
+                     {"adaptive", t.adaptive},   {"initial_data_order", t.initial_data_order},
+                     {"reformulations", t.reformulations}};
+      out["schemes"].push_back(j);
+    }
+  }
+  return out;
+}
+
+std::string list_text(const Registry& registry, const std::string& what) {
+  const Json all = list_json(registry, what);
+  std::string s;
+  for (const char* kind : {"models", "reformulations", "schemes"}) {
+    if (!all.contains(kind)) continue;
+    s += fmt::format("{}{}:\n", s.empty() ? "" : "\n", kind);
+    for (const auto& e : all[kind]) {
+      std::string aliases;
+      for (const auto& a : e["aliases"]) aliases += (aliases.empty() ? "" : ", ") + a.get<std::string>();
+      s += fmt::format("  {}{}  {}\n", e["name"].get<std::string>(),
+                       aliases.empty() ? "" : " (" + aliases + ")", e["summary"].get<std::string>());
+      if (e.contains("traits")) {
+        const auto& t = e["traits"];
+        std::string reforms;
+        for (const auto& r : t["reformulations"]) reforms += (reforms.empty() ? "" : ", ") + r.get<std::string>();
+        s += fmt::format("      order {}, {}, {}, data order {}, on: {}\n", t["order"].get<int>(),
+                         t["symmetric"].get<bool>() ? "symmetric" : "not symmetric",
+                         t["implicit"].get<bool>() ? "implicit" : "explicit",
+                         t["initial_data_order"].get<int>(), reforms);
+      }
+      if (e.contains("default_n_tau")) s += fmt::format("      default n_tau {}\n", e["default_n_tau"].get<int>());
+      for (const auto& p : e["params"]) {
+        const std::string def = p["default"].is_null() ? "-" : p["default"].dump();
+        s += fmt::format("      {:<20} {:<10} default {:<8} {}{}\n", p["name"].get<std::string>(),
+                         p["type"].get<std::string>(), def, p["description"].get<std::string>(),
+                         p["expected"].get<std::string>().empty() ? ""
+                                                                  : " [" + p["expected"].get<std::string>() + "]");
+      }
+      s += fmt::format("      provided by {}\n", e["provider"].get<std::string>());
+    }
+  }
+  return s;
+}
+
+}  // namespace tsi::app

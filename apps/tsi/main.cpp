@@ -1,0 +1,100 @@
+// tsi: the runner. Wires model, reformulation and scheme together from a JSON config.
+//   tsi list [models|reformulations|schemes] [--json]
+//   tsi run CONFIG.json [--out DIR] [--set key.path=value ...]
+// Exit codes: 0 success, 1 a run failed (its files are still written), 2 bad input.
+#include <fmt/format.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+
+#include "config.hpp"
+#include "list_command.hpp"
+#include "plugin_setup.hpp"
+#include "run.hpp"
+#include "run_files.hpp"
+#include "summary.hpp"
+#include "tsi/error.hpp"
+#include "tsi/version.hpp"
+
+namespace {
+
+using tsi::Json;
+
+int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::string& config_path,
+                std::string out_dir, const std::vector<std::string>& overrides) {
+  Json raw = tsi::app::load_config_file(config_path);
+  for (const auto& assignment : overrides) tsi::app::apply_override(raw, assignment);
+  if (raw.is_object() && raw.contains("plugins"))
+    tsi::app::load_config_plugins(loader, raw["plugins"], config_path);
+  const Json config = tsi::app::resolve_run_config(raw, registry);
+  if (out_dir.empty()) out_dir = "out/" + std::filesystem::path(config_path).stem().string();
+
+  const bool tty = isatty(fileno(stderr));
+  auto progress = [&](double fraction) {
+    if (tty) fmt::print(stderr, "\r  running: {:5.1f}%", 100.0 * fraction);
+  };
+  const tsi::app::RunOutcome outcome = tsi::app::execute_run(config, registry, progress);
+  if (tty) fmt::print(stderr, "\r{:30}\r", "");
+  tsi::app::write_run_files(out_dir, outcome);
+  fmt::print("{}", tsi::app::run_summary(outcome, out_dir));
+  if (!outcome.ok) {
+    spdlog::error("run failed: {}", outcome.message);
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  spdlog::set_default_logger(spdlog::stderr_color_st("tsi"));
+  spdlog::set_pattern("tsi: %^%l%$: %v");
+
+  CLI::App app{"tsi: uniformly accurate two-scale integrators for highly oscillatory systems"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", tsi::version_string);
+  std::vector<std::string> plugin_files;
+  app.add_option("--plugin", plugin_files, "load a plugin library (repeatable)")->check(CLI::ExistingFile);
+
+  auto* list = app.add_subcommand("list", "list registered models, reformulations and schemes");
+  std::string what;
+  bool as_json = false;
+  list->add_option("what", what, "models, reformulations or schemes (default: all)");
+  list->add_flag("--json", as_json, "print JSON");
+
+  auto* run = app.add_subcommand("run", "run one config and write result.json and invariants.csv");
+  std::string config_path, out_dir;
+  std::vector<std::string> overrides;
+  run->add_option("config", config_path, "the run config (JSON)")->required();
+  run->add_option("--out", out_dir, "output directory (default: out/<config name>)");
+  run->add_option("--set", overrides, "override a config value: key.path=value (repeatable)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  try {
+    tsi::Registry& registry = tsi::Registry::global();
+    tsi::PluginLoader loader(registry);
+    for (const auto& warning : tsi::app::load_plugins(loader, registry, plugin_files))
+      spdlog::warn("plugin not loaded: {}", warning);
+    if (list->parsed()) {
+      fmt::print("{}", as_json ? tsi::app::list_json(registry, what).dump(2) + "\n"
+                               : tsi::app::list_text(registry, what));
+      return 0;
+    }
+    return run_command(loader, registry, config_path, out_dir, overrides);
+  } catch (const tsi::Error& e) {
+    spdlog::error("{}", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    spdlog::error("unexpected: {}", e.what());
+    return 2;
+  }
+}

@@ -1,0 +1,41 @@
+#include "summary.hpp"
+
+#include <fmt/format.h>
+
+namespace tsi::app {
+
+std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
+  const Json& r = outcome.result;
+  const Json& c = r["config"];
+  std::string s;
+  s += fmt::format("tsi {}  {} (eps = {:g})  scheme {} on {}\n", r["tsi_version"].get<std::string>(),
+                   c["model"]["name"].get<std::string>(), c["model"]["eps"].get<double>(),
+                   c["scheme"]["name"].get<std::string>(), c["reformulation"]["name"].get<std::string>());
+  s += fmt::format("  h = {:g}, t_end = {:g}, steps = {}\n", c["time"]["h"].get<double>(),
+                   c["time"]["t_end"].get<double>(), r.value("steps", 0L));
+  if (!outcome.ok) {
+    s += fmt::format("  FAILED: {}\n", outcome.message);
+  } else {
+    if (r.contains("error"))
+      s += fmt::format("  relative error at t_end   {:.3e}   (reference {} on {}, tol {:g})\n",
+                       r["error"]["relative"].get<double>(), r["error"]["reference"]["scheme"].get<std::string>(),
+                       r["error"]["reference"]["reformulation"].get<std::string>(),
+                       r["error"]["reference"]["tol"].get<double>());
+    for (const char* name : {"H", "I", "m"})
+      s += fmt::format("  max rel. change of {}     {:.3e}   ({:.10g} -> {:.10g})\n", name,
+                       r["invariants"][name]["max_rel_error"].get<double>(),
+                       r["invariants"][name]["initial"].get<double>(), r["invariants"][name]["final"].get<double>());
+    const Json& sv = r["solver"];
+    if (sv["stages"].get<long>() > 0)
+      s += fmt::format("  fixed-point sweeps/stage  {:.2f} mean, {} max, {} not converged\n",
+                       sv["iterations_mean"].get<double>(), sv["iterations_max"].get<long>(),
+                       sv["not_converged"].get<long>());
+    s += fmt::format("  nonlinearity evaluations  {}\n", r["rhs_evaluations"].get<long>());
+    s += fmt::format("  wall time                 {:.3f} s\n", r["wall_seconds"].get<double>());
+  }
+  for (const auto& w : r["warnings"]) s += fmt::format("  warning: {}\n", w.get<std::string>());
+  s += fmt::format("  written: {0}/result.json, {0}/invariants.csv\n", out_dir);
+  return s;
+}
+
+}  // namespace tsi::app

@@ -1,0 +1,37 @@
+#pragma once
+#include <complex>
+#include <memory>
+
+#include "tsi/export.hpp"
+#include "tsi/types.hpp"
+
+namespace tsi {
+
+/// In-place complex FFTs along the tau direction of a batch of states stored column by
+/// column (howmany rows, n columns; entry (i, j) at i + howmany * j). Plans are made once
+/// in the constructor (planning is serialised across threads) and reused by every call.
+class TSI_API FftBatch {
+ public:
+  FftBatch(int n, int howmany);
+  ~FftBatch();
+  FftBatch(const FftBatch&) = delete;
+  FftBatch& operator=(const FftBatch&) = delete;
+
+  /// The work buffer, howmany x n.
+  Eigen::Map<Matrix> data();
+  /// Values at tau_j = 2*pi*j/n -> Fourier coefficients (normalised by 1/n).
+  void forward();
+  /// Fourier coefficients -> values at tau_j.
+  void backward();
+
+  int n() const { return n_; }
+  int howmany() const { return howmany_; }
+
+ private:
+  int n_, howmany_;
+  Complex* buffer_;
+  void* forward_plan_;
+  void* backward_plan_;
+};
+
+}  // namespace tsi

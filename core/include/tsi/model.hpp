@@ -1,0 +1,68 @@
+#pragma once
+#include "tsi/export.hpp"
+#include "tsi/types.hpp"
+
+namespace tsi {
+
+/// The problem class of the paper (eq. model):
+///     u' = J [ (1/eps) M u + grad H1(u) ],   eps in (0, 1],
+/// J symplectic, M self-adjoint, JM = MJ, and tau -> e^{JM tau} 2*pi-periodic.
+/// A model states its operators by their action; batched calls take one state per column
+/// so that the two-scale reformulation evaluates all tau points in one call.
+class TSI_API Model {
+ public:
+  virtual ~Model() = default;
+  Model(const Model&) = delete;
+  Model& operator=(const Model&) = delete;
+
+  double eps() const { return eps_; }
+
+  /// Number of entries of u.
+  virtual Index dim() const = 0;
+  /// True when u is genuinely complex; a real model keeps zero imaginary parts.
+  virtual bool is_complex() const = 0;
+
+  /// The exact linear flow e^{JM tau}, applied in place to column j with phase taus[j].
+  virtual void linear_flow(const RealVector& taus, MatrixRef states) const = 0;
+  /// J grad H1(u) for every column u of `states` (the nonlinear vector field).
+  virtual void nonlinear_field(ConstMatrixRef states, MatrixRef out) const = 0;
+  /// J Hess H1(u) z for every column pair (u, z): the field's derivative at u in direction z.
+  /// The default is a central difference; models with a closed form should override it.
+  virtual void nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef directions,
+                                          MatrixRef out) const;
+  /// M u.
+  virtual void apply_M(const Vector& u, Vector& out) const = 0;
+  /// J u.
+  virtual void apply_J(const Vector& u, Vector& out) const = 0;
+  /// The non-stiff part H1 of the Hamiltonian.
+  virtual double H1(const Vector& u) const = 0;
+
+  /// Oscillatory energy I(u) = <Mu, u> / (2 eps).
+  virtual double oscillatory_energy(const Vector& u) const;
+  /// Mass m(u) = <u, u>.
+  virtual double mass(const Vector& u) const;
+  /// Energy H(u) = I(u) + H1(u), exactly conserved by the flow.
+  double energy(const Vector& u) const { return oscillatory_energy(u) + H1(u); }
+
+  /// The model's default initial value u0 (model variables).
+  virtual Vector initial_value() const = 0;
+  /// Model variables from a user-given initial value in physical variables (identity by default).
+  virtual Vector from_physical(const Vector& x) const { return x; }
+  /// The physical state errors and output are measured in (identity by default).
+  virtual Vector to_physical(const Vector& u) const { return u; }
+  /// The norm relative errors are measured in, on physical states (Euclidean by default).
+  virtual double error_norm(const Vector& x) const { return x.norm(); }
+
+  /// e^{JM tau} applied to one state.
+  Vector linear_flow(double tau, const Vector& u) const;
+  /// J grad H1(u) for one state.
+  Vector nonlinear_field(const Vector& u) const;
+
+ protected:
+  explicit Model(double eps);
+
+ private:
+  double eps_;
+};
+
+}  // namespace tsi

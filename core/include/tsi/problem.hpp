@@ -1,0 +1,37 @@
+#pragma once
+#include "tsi/export.hpp"
+#include "tsi/types.hpp"
+
+namespace tsi {
+
+/// The problem a stepper integrates:  y' = L y + N(t, y).
+/// L is diagonal in the problem's coordinates when linear_multipliers() has one entry per
+/// unknown (two-scale: -i k / eps per tau-Fourier mode; filtered: all zero); it is empty
+/// when L is not diagonal (direct), and then only rhs() is available.
+class TSI_API Problem {
+ public:
+  virtual ~Problem() = default;
+
+  /// Number of (complex) unknowns.
+  virtual Index size() const = 0;
+  /// The diagonal of L, or an empty vector when L is not diagonal in these coordinates.
+  virtual const Vector& linear_multipliers() const = 0;
+  bool has_diagonal_linear_part() const { return linear_multipliers().size() == size(); }
+  /// True when N does not depend on t.
+  virtual bool autonomous() const = 0;
+
+  /// out = N(t, y).
+  virtual void nonlinear(double t, const Vector& y, Vector& out) = 0;
+  /// out = DN(t, y) dy, the derivative of N at y in direction dy.
+  virtual void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) = 0;
+  /// out = L y + N(t, y).
+  virtual void rhs(double t, const Vector& y, Vector& out) = 0;
+
+  /// Evaluations of N (or of rhs) since construction: the work measure of a run.
+  long evaluations() const { return evaluations_; }
+
+ protected:
+  long evaluations_ = 0;
+};
+
+}  // namespace tsi

@@ -1,0 +1,29 @@
+#pragma once
+#include <memory>
+
+#include "tsi/export.hpp"
+#include "tsi/model.hpp"
+#include "tsi/problem.hpp"
+
+namespace tsi {
+
+/// Turns a model into a Problem (SPEC.md section 2) and reads the answer back:
+/// two-scale U(t, tau), filtered v = e^{-JM t/eps} u, or direct u.
+class TSI_API Reformulation : public Problem {
+ public:
+  explicit Reformulation(std::shared_ptr<const Model> model) : model_(std::move(model)) {}
+
+  /// The initial state y(0) of the problem for the model's initial value u0.
+  virtual Vector prepare(const Vector& u0) = 0;
+  /// u(t) in model variables from the problem state y at time t.
+  virtual Vector read_back(const Vector& y, double t) = 0;
+  /// Fraction of the energy of y in the top quarter of the tau spectrum (0 without tau).
+  virtual double tau_roughness(const Vector& /*y*/) const { return 0.0; }
+
+  const Model& model() const { return *model_; }
+
+ protected:
+  std::shared_ptr<const Model> model_;
+};
+
+}  // namespace tsi

@@ -1,0 +1,96 @@
+#pragma once
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "tsi/export.hpp"
+#include "tsi/model.hpp"
+#include "tsi/params.hpp"
+#include "tsi/reformulation.hpp"
+#include "tsi/stepper.hpp"
+
+namespace tsi {
+
+/// What every registered object tells about itself.
+struct TSI_API EntryInfo {
+  std::string name;
+  std::vector<std::string> aliases;
+  std::string summary;   ///< one line
+  ParamSchema params;    ///< the parameters its config section accepts
+  std::string provider;  ///< "core" or the plugin file that registered it (set by the registry)
+};
+
+using ModelFactory = std::function<std::unique_ptr<Model>(const Params&)>;
+using ReformulationFactory =
+    std::function<std::unique_ptr<Reformulation>(std::shared_ptr<const Model>, const Params&)>;
+using StepperFactory = std::function<std::unique_ptr<Stepper>(const Params&)>;
+
+struct TSI_API ModelEntry {
+  EntryInfo info;
+  int default_n_tau = 64;  ///< tau resolution for the two-scale reformulation (SPEC.md sec. 4)
+  ModelFactory create;
+};
+
+struct TSI_API ReformulationEntry {
+  EntryInfo info;
+  ReformulationFactory create;
+};
+
+struct TSI_API SchemeEntry {
+  EntryInfo info;
+  StepperTraits traits;
+  StepperFactory create;
+};
+
+/// The runtime registry of models, reformulations and schemes (PETSc TSRegister / OpenFOAM
+/// runtime selection). Look-ups accept names and aliases; a miss lists the valid names.
+class TSI_API Registry {
+ public:
+  enum class Kind { Model, Reformulation, Scheme };
+
+  /// The process-wide registry that the runner and all plugins share.
+  static Registry& global();
+
+  Registry();
+  ~Registry();
+  Registry(const Registry&) = delete;
+  Registry& operator=(const Registry&) = delete;
+
+  /// Registration. A name or alias already taken (within its kind) is a PluginError that
+  /// names who provided it first. Every model gets the common parameters "eps" and "u0".
+  void add_model(ModelEntry entry);
+  void add_reformulation(ReformulationEntry entry);
+  void add_scheme(SchemeEntry entry);
+
+  /// Look-ups by name or alias; `field` is the config path reported on a miss.
+  const ModelEntry& model(const std::string& name, const std::string& field = "model.name") const;
+  const ReformulationEntry& reformulation(const std::string& name,
+                                          const std::string& field = "reformulation.name") const;
+  const SchemeEntry& scheme(const std::string& name, const std::string& field = "scheme.name") const;
+
+  /// Entries sorted by name.
+  std::vector<const ModelEntry*> models() const;
+  std::vector<const ReformulationEntry*> reformulations() const;
+  std::vector<const SchemeEntry*> schemes() const;
+
+  /// Refuses a scheme/reformulation pair the scheme does not support, naming the compatible
+  /// reformulations.
+  void check_compatible(const SchemeEntry& scheme, const ReformulationEntry& reformulation) const;
+
+  /// The provider stamped on entries added from now on ("core" by default).
+  void set_provider(std::string provider);
+  const std::string& provider() const;
+  /// Removes everything a provider added (a plugin whose registration failed half-way).
+  void remove_provider(const std::string& provider);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Registers the three reformulations of the core (two-scale, filtered, direct).
+TSI_API void register_core(Registry& registry);
+
+}  // namespace tsi

@@ -1,0 +1,12 @@
+#pragma once
+#include <cstdint>
+
+namespace tsi {
+
+/// The tsi release (semantic versioning).
+inline constexpr int version_major = 0;
+inline constexpr int version_minor = 1;
+inline constexpr int version_patch = 0;
+inline constexpr const char* version_string = "0.1.0";
+
+}  // namespace tsi

@@ -1,0 +1,28 @@
+#pragma once
+#include "tsi/reformulation.hpp"
+
+namespace tsi {
+
+/// The model as it stands: y = u, y' = (1/eps) JM y + J grad H1(y). L is not diagonal in
+/// these coordinates, so only schemes that use rhs() (classical solvers) apply.
+class Direct final : public Reformulation {
+ public:
+  explicit Direct(std::shared_ptr<const Model> model);
+
+  Index size() const override { return model_->dim(); }
+  const Vector& linear_multipliers() const override { return none_; }
+  bool autonomous() const override { return true; }
+  void nonlinear(double t, const Vector& y, Vector& out) override;
+  void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
+  void rhs(double t, const Vector& y, Vector& out) override;
+
+  Vector prepare(const Vector& u0) override { return u0; }
+  Vector read_back(const Vector& y, double /*t*/) override { return y; }
+
+ private:
+  Vector none_;
+  Matrix state_, direction_, field_;
+  Vector mu_, jmu_;
+};
+
+}  // namespace tsi

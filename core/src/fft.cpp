@@ -1,0 +1,45 @@
+#include "tsi/fft.hpp"
+
+#include <fftw3.h>
+
+#include <mutex>
+
+#include "tsi/error.hpp"
+
+namespace tsi {
+namespace {
+// FFTW's planner is not thread-safe; execution of distinct plans is.
+std::mutex planner_mutex;
+}  // namespace
+
+FftBatch::FftBatch(int n, int howmany) : n_(n), howmany_(howmany) {
+  if (n <= 0 || howmany <= 0) throw Error("FftBatch: sizes must be positive");
+  std::lock_guard<std::mutex> lock(planner_mutex);
+  buffer_ = reinterpret_cast<Complex*>(fftw_alloc_complex(static_cast<size_t>(n) * howmany));
+  auto* raw = reinterpret_cast<fftw_complex*>(buffer_);
+  // Transform along tau: n points with stride howmany, one transform per component.
+  forward_plan_ = fftw_plan_many_dft(1, &n_, howmany_, raw, nullptr, howmany_, 1, raw, nullptr,
+                                     howmany_, 1, FFTW_FORWARD, FFTW_ESTIMATE);
+  backward_plan_ = fftw_plan_many_dft(1, &n_, howmany_, raw, nullptr, howmany_, 1, raw, nullptr,
+                                      howmany_, 1, FFTW_BACKWARD, FFTW_ESTIMATE);
+  if (!forward_plan_ || !backward_plan_) throw Error("FftBatch: FFTW could not make a plan");
+  data().setZero();
+}
+
+FftBatch::~FftBatch() {
+  std::lock_guard<std::mutex> lock(planner_mutex);
+  fftw_destroy_plan(static_cast<fftw_plan>(forward_plan_));
+  fftw_destroy_plan(static_cast<fftw_plan>(backward_plan_));
+  fftw_free(buffer_);
+}
+
+Eigen::Map<Matrix> FftBatch::data() { return Eigen::Map<Matrix>(buffer_, howmany_, n_); }
+
+void FftBatch::forward() {
+  fftw_execute(static_cast<fftw_plan>(forward_plan_));
+  data() *= 1.0 / n_;
+}
+
+void FftBatch::backward() { fftw_execute(static_cast<fftw_plan>(backward_plan_)); }
+
+}  // namespace tsi

@@ -1,0 +1,42 @@
+#include "filtered.hpp"
+
+#include "tsi/phase.hpp"
+
+namespace tsi {
+
+Filtered::Filtered(std::shared_ptr<const Model> model)
+    : Reformulation(std::move(model)),
+      zeros_(Vector::Zero(model_->dim())),
+      tau_(1),
+      state_(model_->dim(), 1),
+      direction_(model_->dim(), 1),
+      field_(model_->dim(), 1) {}
+
+void Filtered::nonlinear(double t, const Vector& y, Vector& out) {
+  ++evaluations_;
+  tau_(0) = fast_phase(t, model_->eps());
+  state_.col(0) = y;
+  model_->linear_flow(tau_, state_);
+  model_->nonlinear_field(state_, field_);
+  tau_(0) = -tau_(0);
+  model_->linear_flow(tau_, field_);
+  out = field_.col(0);
+}
+
+void Filtered::nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) {
+  tau_(0) = fast_phase(t, model_->eps());
+  state_.col(0) = y;
+  direction_.col(0) = dy;
+  model_->linear_flow(tau_, state_);
+  model_->linear_flow(tau_, direction_);
+  model_->nonlinear_field_derivative(state_, direction_, field_);
+  tau_(0) = -tau_(0);
+  model_->linear_flow(tau_, field_);
+  out = field_.col(0);
+}
+
+Vector Filtered::read_back(const Vector& y, double t) {
+  return model_->linear_flow(fast_phase(t, model_->eps()), y);
+}
+
+}  // namespace tsi

@@ -1,0 +1,28 @@
+#pragma once
+#include "tsi/reformulation.hpp"
+
+namespace tsi {
+
+/// The filtered problem (eq. filtered): v = e^{-JM t/eps} u,  v' = f_{t/eps}(v).
+/// No stiff linear part (L = 0, diagonal), but non-autonomous with period 2*pi*eps in t.
+class Filtered final : public Reformulation {
+ public:
+  explicit Filtered(std::shared_ptr<const Model> model);
+
+  Index size() const override { return model_->dim(); }
+  const Vector& linear_multipliers() const override { return zeros_; }
+  bool autonomous() const override { return false; }
+  void nonlinear(double t, const Vector& y, Vector& out) override;
+  void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
+  void rhs(double t, const Vector& y, Vector& out) override { nonlinear(t, y, out); }
+
+  Vector prepare(const Vector& u0) override { return u0; }
+  Vector read_back(const Vector& y, double t) override;
+
+ private:
+  Vector zeros_;
+  RealVector tau_;  // one phase, reused
+  Matrix state_, direction_, field_;
+};
+
+}  // namespace tsi

@@ -1,0 +1,60 @@
+#include "tsi/model.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "tsi/error.hpp"
+
+namespace tsi {
+
+Model::Model(double eps) : eps_(eps) {
+  if (!(eps > 0.0 && eps <= 1.0)) throw ConfigError("model.eps", "expected a number in (0, 1]");
+}
+
+void Model::nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef directions,
+                                       MatrixRef out) const {
+  // Central difference with a step balancing truncation (delta^2) and rounding (1/delta).
+  const double delta = std::cbrt(std::numeric_limits<double>::epsilon());
+  Matrix plus(states.rows(), states.cols()), minus(states.rows(), states.cols());
+  for (Index j = 0; j < states.cols(); ++j) {
+    const double scale = std::max(1.0, states.col(j).norm()) / std::max(directions.col(j).norm(), 1e-300);
+    plus.col(j) = states.col(j) + delta * scale * directions.col(j);
+    minus.col(j) = states.col(j) - delta * scale * directions.col(j);
+  }
+  Matrix f_plus(states.rows(), states.cols()), f_minus(states.rows(), states.cols());
+  nonlinear_field(plus, f_plus);
+  nonlinear_field(minus, f_minus);
+  for (Index j = 0; j < states.cols(); ++j) {
+    const double dn = directions.col(j).norm();
+    if (dn == 0.0) {
+      out.col(j).setZero();
+      continue;
+    }
+    const double scale = std::max(1.0, states.col(j).norm()) / dn;
+    out.col(j) = (f_plus.col(j) - f_minus.col(j)) / (2.0 * delta * scale);
+  }
+}
+
+double Model::oscillatory_energy(const Vector& u) const {
+  Vector mu(u.size());
+  apply_M(u, mu);
+  return inner(mu, u) / (2.0 * eps_);
+}
+
+double Model::mass(const Vector& u) const { return inner(u, u); }
+
+Vector Model::linear_flow(double tau, const Vector& u) const {
+  Matrix states = u;
+  RealVector taus(1);
+  taus(0) = tau;
+  linear_flow(taus, states);
+  return states.col(0);
+}
+
+Vector Model::nonlinear_field(const Vector& u) const {
+  Matrix out(u.size(), 1);
+  nonlinear_field(Matrix(u), out);
+  return out.col(0);
+}
+
+}  // namespace tsi

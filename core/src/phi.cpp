@@ -1,0 +1,52 @@
+#include "tsi/phi.hpp"
+
+#include <array>
+#include <cmath>
+
+namespace tsi {
+namespace {
+
+// Below this modulus the Taylor series is used: 1/(k+2)! < 2^-53 for k >= 17, and the
+// terms fall at least geometrically, so 24 terms leave the sum exact to rounding.
+constexpr double series_radius = 1.0;
+constexpr int series_terms = 24;
+
+// 1/n! for n = 0 .. series_terms + 2, each from the previous by one division.
+const std::array<double, series_terms + 3>& inverse_factorials() {
+  static const auto table = [] {
+    std::array<double, series_terms + 3> t{};
+    t[0] = 1.0;
+    for (int n = 1; n < static_cast<int>(t.size()); ++n) t[n] = t[n - 1] / n;
+    return t;
+  }();
+  return table;
+}
+
+// sum_{k>=0} z^k / (k + shift)!  for |z| <= 1, by Horner from the tail.
+Complex series(Complex z, int shift) {
+  const auto& c = inverse_factorials();
+  Complex sum = 0.0;
+  for (int k = series_terms; k >= 0; --k) sum = sum * z + c[k + shift];
+  return sum;
+}
+
+}  // namespace
+
+Complex expm1(Complex z) {
+  // Re(e^z - 1) = expm1(x) cos y - 2 sin^2(y/2); Im = e^x sin y: no cancellation near 0.
+  const double x = z.real(), y = z.imag();
+  const double s = std::sin(0.5 * y);
+  return {std::expm1(x) * std::cos(y) - 2.0 * s * s, std::exp(x) * std::sin(y)};
+}
+
+Complex phi1(Complex z) {
+  if (std::abs(z) <= series_radius) return series(z, 1);
+  return expm1(z) / z;
+}
+
+Complex phi2(Complex z) {
+  if (std::abs(z) <= series_radius) return series(z, 2);
+  return (expm1(z) - z) / (z * z);
+}
+
+}  // namespace tsi

@@ -1,0 +1,55 @@
+#include <memory>
+
+#include "direct.hpp"
+#include "filtered.hpp"
+#include "tsi/registry.hpp"
+#include "two_scale.hpp"
+
+namespace tsi {
+
+void register_core(Registry& registry) {
+  const auto previous = registry.provider();
+  registry.set_provider("core");
+
+  ReformulationEntry two_scale;
+  two_scale.info = {
+      "two-scale",
+      {"2scale", "tsi"},
+      "U(t, tau) with dU/dt + (1/eps) dU/dtau = f_tau(U), Fourier in tau (eq. 2scale eq)",
+      {integer_param("n_tau", nullptr, "Fourier points in tau; default: the model's own")
+           .check([](const Json& v) { return v.get<long>() > 0 && v.get<long>() % 2 == 0; },
+                  "a positive even integer"),
+       integer_param("initial_data_order", nullptr,
+                     "order of the prepared initial data (1, 2 or 3); default: what the scheme "
+                     "needs for uniform second order")
+           .check([](const Json& v) { return v.get<long>() >= 1 && v.get<long>() <= 3; },
+                  "1, 2 or 3")},
+      ""};
+  two_scale.create = [](std::shared_ptr<const Model> model, const Params& p) {
+    const int n_tau = p.has("n_tau") ? static_cast<int>(p.integer("n_tau")) : 64;
+    const int order = p.has("initial_data_order") ? static_cast<int>(p.integer("initial_data_order")) : 2;
+    return std::make_unique<TwoScale>(std::move(model), n_tau, order);
+  };
+  registry.add_reformulation(std::move(two_scale));
+
+  ReformulationEntry filtered;
+  filtered.info = {"filtered", {"filter"},
+                   "v = e^{-JM t/eps} u, v' = f_{t/eps}(v): no stiff part, period 2 pi eps in t",
+                   {}, ""};
+  filtered.create = [](std::shared_ptr<const Model> model, const Params&) {
+    return std::make_unique<Filtered>(std::move(model));
+  };
+  registry.add_reformulation(std::move(filtered));
+
+  ReformulationEntry direct;
+  direct.info = {"direct", {}, "u' = J[(1/eps) M u + grad H1(u)] as it stands (classical solvers)",
+                 {}, ""};
+  direct.create = [](std::shared_ptr<const Model> model, const Params&) {
+    return std::make_unique<Direct>(std::move(model));
+  };
+  registry.add_reformulation(std::move(direct));
+
+  registry.set_provider(previous);
+}
+
+}  // namespace tsi

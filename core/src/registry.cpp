@@ -1,0 +1,162 @@
+#include "tsi/registry.hpp"
+
+#include <algorithm>
+
+#include "tsi/error.hpp"
+
+namespace tsi {
+
+namespace {
+
+std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+
+std::string join(const std::vector<std::string>& words) {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
+  return out;
+}
+
+/// The entries of one kind, by name, plus the alias -> name map. std::map keeps entries
+/// at stable addresses and sorted by name.
+template <class Entry>
+struct Table {
+  std::string kind;    ///< "model", "reformulation", "scheme"
+  std::string plural;  ///< "models", ...
+  std::map<std::string, Entry> entries;
+  std::map<std::string, std::string> aliases;
+
+  /// The entry a name or alias denotes, or nullptr.
+  const Entry* find(const std::string& key) const {
+    auto it = entries.find(key);
+    if (it != entries.end()) return &it->second;
+    auto alias = aliases.find(key);
+    return alias == aliases.end() ? nullptr : &entries.at(alias->second);
+  }
+
+  /// Refuses a name or alias that is already taken, naming who took it.
+  void check_free(const std::string& key, const std::string& provider) const {
+    const Entry* taken = find(key);
+    if (!taken) return;
+    const std::string as = taken->info.name == key ? "" : " as an alias of " + quoted(taken->info.name);
+    throw PluginError(kind + " " + quoted(key) + " is already registered by " + taken->info.provider +
+                      as + " (while registering from " + provider + ")");
+  }
+
+  void add(Entry entry, const std::string& provider) {
+    check_free(entry.info.name, provider);
+    for (const auto& alias : entry.info.aliases) check_free(alias, provider);
+    entry.info.provider = provider;
+    const std::string name = entry.info.name;
+    for (const auto& alias : entry.info.aliases) {
+      if (alias != name) aliases[alias] = name;
+    }
+    entries.emplace(name, std::move(entry));
+  }
+
+  const Entry& get(const std::string& key, const std::string& field) const {
+    if (const Entry* e = find(key)) return *e;
+    if (entries.empty()) throw ConfigError(field, "unknown " + kind + " " + quoted(key) + "; no " + plural + " are registered");
+    std::string list;
+    for (const auto& [name, e] : entries) {
+      list += (list.empty() ? "" : ", ") + name;
+      const auto& a = e.info.aliases;
+      if (!a.empty()) list += (a.size() == 1 ? " (alias: " : " (aliases: ") + join(a) + ")";
+    }
+    throw ConfigError(field, "unknown " + kind + " " + quoted(key) + "; valid " + plural + " are: " + list);
+  }
+
+  std::vector<const Entry*> sorted() const {
+    std::vector<const Entry*> out;
+    for (const auto& [name, e] : entries) out.push_back(&e);
+    return out;
+  }
+
+  void remove_provider(const std::string& provider) {
+    std::erase_if(entries, [&](const auto& kv) { return kv.second.info.provider == provider; });
+    std::erase_if(aliases, [&](const auto& kv) { return !entries.contains(kv.second); });
+  }
+};
+
+bool has_param(const ParamSchema& schema, const std::string& name) {
+  return std::any_of(schema.begin(), schema.end(), [&](const ParamSpec& s) { return s.name == name; });
+}
+
+}  // namespace
+
+struct Registry::Impl {
+  Table<ModelEntry> models{"model", "models", {}, {}};
+  Table<ReformulationEntry> reformulations{"reformulation", "reformulations", {}, {}};
+  Table<SchemeEntry> schemes{"scheme", "schemes", {}, {}};
+  std::string provider = "core";
+};
+
+Registry& Registry::global() {
+  static Registry registry;
+  return registry;
+}
+
+Registry::Registry() : impl_(std::make_unique<Impl>()) {}
+Registry::~Registry() = default;
+
+void Registry::add_model(ModelEntry entry) {
+  auto& params = entry.info.params;
+  if (!has_param(params, "eps")) {
+    params.push_back(number_param("eps", 0.01, "the small parameter: stiffness 1/eps of the linear part")
+                         .range(0.0, 1.0, true, false));
+  }
+  if (!has_param(params, "u0")) {
+    params.push_back(array_param("u0", "initial value in physical variables; default: the model's own"));
+  }
+  impl_->models.add(std::move(entry), impl_->provider);
+}
+
+void Registry::add_reformulation(ReformulationEntry entry) {
+  impl_->reformulations.add(std::move(entry), impl_->provider);
+}
+
+void Registry::add_scheme(SchemeEntry entry) { impl_->schemes.add(std::move(entry), impl_->provider); }
+
+const ModelEntry& Registry::model(const std::string& name, const std::string& field) const {
+  return impl_->models.get(name, field);
+}
+
+const ReformulationEntry& Registry::reformulation(const std::string& name, const std::string& field) const {
+  return impl_->reformulations.get(name, field);
+}
+
+const SchemeEntry& Registry::scheme(const std::string& name, const std::string& field) const {
+  return impl_->schemes.get(name, field);
+}
+
+std::vector<const ModelEntry*> Registry::models() const { return impl_->models.sorted(); }
+
+std::vector<const ReformulationEntry*> Registry::reformulations() const {
+  return impl_->reformulations.sorted();
+}
+
+std::vector<const SchemeEntry*> Registry::schemes() const { return impl_->schemes.sorted(); }
+
+void Registry::check_compatible(const SchemeEntry& scheme, const ReformulationEntry& reformulation) const {
+  auto names = scheme.traits.reformulations;
+  const auto supports = [&names](const std::string& n) {
+    return std::find(names.begin(), names.end(), n) != names.end();
+  };
+  const auto& info = reformulation.info;
+  if (supports(info.name) || std::any_of(info.aliases.begin(), info.aliases.end(), supports)) return;
+  std::sort(names.begin(), names.end());
+  throw ConfigError("reformulation.name",
+                    "scheme " + quoted(scheme.info.name) + " cannot integrate the " + quoted(info.name) +
+                        " reformulation; compatible reformulations: " + (names.empty() ? "none" : join(names)));
+}
+
+void Registry::set_provider(std::string provider) { impl_->provider = std::move(provider); }
+
+const std::string& Registry::provider() const { return impl_->provider; }
+
+void Registry::remove_provider(const std::string& provider) {
+  impl_->models.remove_provider(provider);
+  impl_->reformulations.remove_provider(provider);
+  impl_->schemes.remove_provider(provider);
+}
+
+}  // namespace tsi

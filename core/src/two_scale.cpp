@@ -1,0 +1,161 @@
+#include "two_scale.hpp"
+
+#include <cmath>
+
+#include "tsi/error.hpp"
+#include "tsi/phase.hpp"
+
+namespace tsi {
+
+TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order)
+    : Reformulation(std::move(model)),
+      dim_(model_->dim()),
+      n_tau_(n_tau),
+      data_order_(initial_data_order),
+      eps_(model_->eps()),
+      taus_(n_tau),
+      minus_taus_(n_tau),
+      wave_numbers_(n_tau),
+      multipliers_(dim_ * n_tau),
+      fft_(n_tau, static_cast<int>(model_->dim())),
+      field_(dim_, n_tau),
+      grid_(dim_, n_tau) {
+  if (n_tau <= 0 || n_tau % 2 != 0)
+    throw ConfigError("reformulation.n_tau",
+                      "got " + std::to_string(n_tau) + ", expected a positive even integer");
+  if (initial_data_order < 1 || initial_data_order > 3)
+    throw ConfigError("reformulation.initial_data_order",
+                      "got " + std::to_string(initial_data_order) + ", expected 1, 2 or 3");
+  for (int j = 0; j < n_tau; ++j) {
+    taus_(j) = two_pi * j / n_tau;
+    minus_taus_(j) = -taus_(j);
+    wave_numbers_(j) = j <= n_tau / 2 ? j : j - n_tau;
+    // Nyquist: multiplier 0, as the Fourier differentiation matrix has it.
+    const double k = (2 * j == n_tau) ? 0.0 : wave_numbers_(j);
+    multipliers_.segment(j * dim_, dim_).setConstant(Complex(0.0, -k / eps_));
+  }
+}
+
+void TwoScale::nonlinear(double /*t*/, const Vector& y, Vector& out) {
+  ++evaluations_;
+  auto buffer = fft_.data();
+  buffer = Eigen::Map<const Matrix>(y.data(), dim_, n_tau_);
+  fft_.backward();
+  model_->linear_flow(taus_, buffer);
+  model_->nonlinear_field(buffer, field_);
+  model_->linear_flow(minus_taus_, field_);
+  buffer = field_;
+  fft_.forward();
+  out.resize(size());
+  Eigen::Map<Matrix>(out.data(), dim_, n_tau_) = buffer;
+}
+
+void TwoScale::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& dy, Vector& out) {
+  const Matrix c = Eigen::Map<const Matrix>(y.data(), dim_, n_tau_);
+  const Matrix dc = Eigen::Map<const Matrix>(dy.data(), dim_, n_tau_);
+  const Matrix result = df_coefficients(to_grid(c), to_grid(dc));
+  out = Eigen::Map<const Vector>(result.data(), size());
+}
+
+void TwoScale::rhs(double t, const Vector& y, Vector& out) {
+  nonlinear(t, y, out);
+  out += multipliers_.cwiseProduct(y);
+}
+
+Matrix TwoScale::to_grid(const Matrix& c) {
+  auto buffer = fft_.data();
+  buffer = c;
+  fft_.backward();
+  return buffer;
+}
+
+Matrix TwoScale::f_coefficients(const Matrix& grid) {
+  Matrix w = grid;
+  model_->linear_flow(taus_, w);
+  Matrix f(dim_, n_tau_);
+  model_->nonlinear_field(w, f);
+  model_->linear_flow(minus_taus_, f);
+  auto buffer = fft_.data();
+  buffer = f;
+  fft_.forward();
+  return buffer;
+}
+
+Matrix TwoScale::df_coefficients(const Matrix& grid, const Matrix& direction_grid) {
+  Matrix w = grid, z = direction_grid;
+  model_->linear_flow(taus_, w);
+  model_->linear_flow(taus_, z);
+  Matrix df(dim_, n_tau_);
+  model_->nonlinear_field_derivative(w, z, df);
+  model_->linear_flow(minus_taus_, df);
+  auto buffer = fft_.data();
+  buffer = df;
+  fft_.forward();
+  return buffer;
+}
+
+Matrix TwoScale::apply_A(Matrix c) const {
+  for (int j = 0; j < n_tau_; ++j) {
+    if (j == 0 || 2 * j == n_tau_)
+      c.col(j).setZero();
+    else
+      c.col(j) /= Complex(0.0, wave_numbers_(j));
+  }
+  return c;
+}
+
+Matrix TwoScale::r1(const Vector& w) { return apply_A(f_coefficients(w.replicate(1, n_tau_))); }
+
+Matrix TwoScale::r2(const Vector& w) {
+  const Matrix w_grid = w.replicate(1, n_tau_);
+  const Matrix f = f_coefficients(w_grid);
+  const Matrix af_grid = to_grid(apply_A(f));
+  const Matrix mean_f_grid = f.col(0).replicate(1, n_tau_);  // Pi f(w), constant in tau
+  return apply_A(df_coefficients(w_grid, af_grid)) -
+         apply_A(apply_A(df_coefficients(w_grid, mean_f_grid)));
+}
+
+Vector TwoScale::evaluate(const Matrix& c, double tau) const {
+  Vector value = Vector::Zero(dim_);
+  for (int j = 0; j < n_tau_; ++j) {
+    if (2 * j == n_tau_)  // half at +n/2, half at -n/2: a real U stays real
+      value += c.col(j) * std::cos(0.5 * n_tau_ * tau);
+    else
+      value += c.col(j) * std::polar(1.0, wave_numbers_(j) * tau);
+  }
+  return value;
+}
+
+Vector TwoScale::prepare(const Vector& u0) {
+  Matrix c = Matrix::Zero(dim_, n_tau_);
+  if (data_order_ >= 2) {
+    // eq. (2nd data); order 3 evaluates r1 at ubar = u0 - eps r1(u0)(0) and adds eps^2 r2(u0).
+    Matrix r = r1(u0);
+    if (data_order_ == 3) {
+      const Vector ubar = u0 - eps_ * evaluate(r, 0.0);
+      r = r1(ubar) + eps_ * r2(u0);
+    }
+    c = eps_ * r;
+    c.col(0) -= evaluate(c, 0.0);  // U(0, 0) = u0 exactly: subtract the value at tau = 0
+  }
+  c.col(0) += u0;
+  return Eigen::Map<const Vector>(c.data(), size());
+}
+
+Vector TwoScale::read_back(const Vector& y, double t) {
+  const double tau = fast_phase(t, eps_);
+  return model_->linear_flow(tau, evaluate(Eigen::Map<const Matrix>(y.data(), dim_, n_tau_), tau));
+}
+
+double TwoScale::tau_roughness(const Vector& y) const {
+  const Eigen::Map<const Matrix> c(y.data(), dim_, n_tau_);
+  double total = 0.0, top = 0.0;
+  for (int j = 0; j < n_tau_; ++j) {
+    const double e = c.col(j).squaredNorm();
+    total += e;
+    if (8.0 * std::abs(wave_numbers_(j)) > 3.0 * n_tau_) top += e;  // |k| > 3/8 n: top quarter
+  }
+  return total > 0.0 ? top / total : 0.0;
+}
+
+}  // namespace tsi

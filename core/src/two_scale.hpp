@@ -1,0 +1,55 @@
+#pragma once
+#include "tsi/fft.hpp"
+#include "tsi/reformulation.hpp"
+
+namespace tsi {
+
+/// The two-scale reformulation (eq. 2scale eq): U(t, tau) on N_tau Fourier modes,
+///     dU/dt = L U + f_tau(U),   L = -(1/eps) d/dtau,
+/// stored as Fourier coefficients, d x N_tau column-major (column j = mode j), so that L is
+/// diagonal. The Nyquist mode's multiplier is 0 (SPEC.md section 2).
+class TwoScale final : public Reformulation {
+ public:
+  TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order);
+
+  Index size() const override { return dim_ * n_tau_; }
+  const Vector& linear_multipliers() const override { return multipliers_; }
+  bool autonomous() const override { return true; }
+  void nonlinear(double t, const Vector& y, Vector& out) override;
+  void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
+  void rhs(double t, const Vector& y, Vector& out) override;
+
+  /// Prepared initial data of the configured order (eq. 2nd data; SPEC.md for order 3).
+  Vector prepare(const Vector& u0) override;
+  /// u(t) = e^{JM t/eps} U(t, t/eps), U evaluated off the grid by its interpolant.
+  Vector read_back(const Vector& y, double t) override;
+  double tau_roughness(const Vector& y) const override;
+
+ private:
+  /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau).
+  Matrix f_coefficients(const Matrix& grid);
+  /// Coefficients of Df_tau(W(tau)) Z(tau) for grid values W, Z.
+  Matrix df_coefficients(const Matrix& grid, const Matrix& direction_grid);
+  /// Grid values of the coefficients c.
+  Matrix to_grid(const Matrix& c);
+  /// A = (d/dtau)^{-1} (I - Pi) on coefficients: mode k / (i k), modes 0 and Nyquist to 0.
+  Matrix apply_A(Matrix c) const;
+  /// r1(w) = A f_.(w), as coefficients.
+  Matrix r1(const Vector& w);
+  /// r2(w) = A[Df(w) A f(w)] - A^2[Df(w) Pi f(w)], as coefficients.
+  Matrix r2(const Vector& w);
+  /// The trigonometric interpolant of coefficients c at tau (Nyquist split half/half).
+  Vector evaluate(const Matrix& c, double tau) const;
+
+  Index dim_;
+  int n_tau_;
+  int data_order_;
+  double eps_;
+  RealVector taus_, minus_taus_;
+  RealVector wave_numbers_;  // k of each Fourier index; the Nyquist index holds n/2
+  Vector multipliers_;
+  FftBatch fft_;
+  Matrix field_, grid_;  // work space: no allocation inside a step
+};
+
+}  // namespace tsi

@@ -1,0 +1,87 @@
+// The Henon-Heiles model in the form of the paper (eq. HH model; SPEC.md section 4):
+// u = (q1, q2, p1, p2), M = diag(1, 0, 1, 0), J = [[0, I2], [-I2, 0]],
+// H1 = q2^2/2 + p2^2/2 + q1^2 q2 - q2^3/3.
+#include <cmath>
+#include <memory>
+
+#include "tsi/model.hpp"
+#include "tsi/plugin.hpp"
+
+namespace {
+
+using tsi::Complex;
+using tsi::ConstMatrixRef;
+using tsi::Index;
+using tsi::MatrixRef;
+using tsi::Vector;
+
+class HenonHeiles final : public tsi::Model {
+ public:
+  explicit HenonHeiles(double eps) : Model(eps) {}
+
+  Index dim() const override { return 4; }
+  bool is_complex() const override { return false; }
+
+  // JM couples (q1, p1) only: q1' = p1, p1' = -q1 in tau, a rotation of period 2*pi.
+  void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
+    for (Index j = 0; j < u.cols(); ++j) {
+      const double c = std::cos(taus(j)), s = std::sin(taus(j));
+      const Complex q1 = u(0, j), p1 = u(2, j);
+      u(0, j) = c * q1 + s * p1;
+      u(2, j) = -s * q1 + c * p1;
+    }
+  }
+
+  // J grad H1 = (dH1/dp, -dH1/dq).
+  void nonlinear_field(ConstMatrixRef u, MatrixRef out) const override {
+    for (Index j = 0; j < u.cols(); ++j) {
+      const Complex q1 = u(0, j), q2 = u(1, j), p2 = u(3, j);
+      out(0, j) = 0.0;
+      out(1, j) = p2;
+      out(2, j) = -2.0 * q1 * q2;
+      out(3, j) = -q2 - q1 * q1 + q2 * q2;
+    }
+  }
+
+  void nonlinear_field_derivative(ConstMatrixRef u, ConstMatrixRef z, MatrixRef out) const override {
+    for (Index j = 0; j < u.cols(); ++j) {
+      const Complex q1 = u(0, j), q2 = u(1, j);
+      const Complex a = z(0, j), b = z(1, j), d = z(3, j);
+      out(0, j) = 0.0;
+      out(1, j) = d;
+      out(2, j) = -2.0 * (a * q2 + q1 * b);
+      out(3, j) = -b - 2.0 * q1 * a + 2.0 * q2 * b;
+    }
+  }
+
+  void apply_M(const Vector& u, Vector& out) const override {
+    out.resize(4);
+    out << u(0), 0.0, u(2), 0.0;
+  }
+
+  void apply_J(const Vector& u, Vector& out) const override {
+    out.resize(4);
+    out << u(2), u(3), -u(0), -u(1);
+  }
+
+  double H1(const Vector& u) const override {
+    const double q1 = u(0).real(), q2 = u(1).real(), p2 = u(3).real();
+    return 0.5 * q2 * q2 + 0.5 * p2 * p2 + q1 * q1 * q2 - q2 * q2 * q2 / 3.0;
+  }
+
+  Vector initial_value() const override { return Vector::Constant(4, 0.12); }
+};
+
+void register_henon_heiles(tsi::Registry& registry) {
+  tsi::ModelEntry entry;
+  entry.info.name = "henon-heiles";
+  entry.info.aliases = {"hh"};
+  entry.info.summary = "Henon-Heiles with a fast (q1, p1) oscillator (eq. HH model), dim 4";
+  entry.default_n_tau = 64;
+  entry.create = [](const tsi::Params& p) { return std::make_unique<HenonHeiles>(p.number("eps")); };
+  registry.add_model(std::move(entry));
+}
+
+}  // namespace
+
+TSI_PLUGIN("henon-heiles", register_henon_heiles)

@@ -1,0 +1,148 @@
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <filesystem>
+
+#include "tsi/error.hpp"
+#include "tsi/plugin_loader.hpp"
+#include "tsi/version.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// The built fixture tsi_fixture_<name>.so, canonical (the loader stamps canonical paths).
+std::string fixture(const std::string& name) {
+  const fs::path p = fs::path(TSI_TEST_FIXTURE_DIR) / ("tsi_fixture_" + name + ".so");
+  REQUIRE_MESSAGE(fs::exists(p), "fixture not built: " << p.string());
+  return fs::canonical(p).string();
+}
+
+/// Total number of entries of all kinds.
+std::size_t size(const tsi::Registry& r) {
+  return r.models().size() + r.reformulations().size() + r.schemes().size();
+}
+
+/// Loads `path` into a fresh registry, expecting a PluginError containing `words`, and
+/// checks that nothing was registered.
+void expect_refused(const std::string& path, const std::string& words) {
+  tsi::Registry r;
+  tsi::PluginLoader loader(r);
+  CHECK_THROWS_WITH_AS(loader.load(path), doctest::Contains(words.c_str()), tsi::PluginError);
+  CHECK(size(r) == 0);
+  CHECK(r.provider() == "core");
+  REQUIRE(loader.reports().size() == 1);
+  CHECK_FALSE(loader.reports()[0].ok);
+}
+
+}  // namespace
+
+TEST_CASE("loader: a good plugin registers its names under its own path") {
+  tsi::Registry r;
+  tsi::PluginLoader loader(r);
+  const std::string path = fixture("good");
+  loader.load(path);
+  CHECK(r.model("fixture-model").info.provider == path);
+  CHECK(&r.model("fm") == &r.model("fixture-model"));
+  CHECK(r.scheme("fixture-scheme").info.provider == path);
+  CHECK(r.provider() == "core");
+  REQUIRE(loader.reports().size() == 1);
+  CHECK(loader.reports()[0].ok);
+  CHECK(loader.reports()[0].name == "fixture-good");
+
+  SUBCASE("its factories work") {
+    tsi::Params params(tsi::resolve_params(r.model("fm").info.params, tsi::Json{{"eps", 0.5}}, "model"));
+    auto model = r.model("fm").create(params);
+    REQUIRE(model);
+    CHECK(model->eps() == doctest::Approx(0.5));
+    CHECK(model->dim() == 2);
+    CHECK(r.scheme("fixture-scheme").create(tsi::Params{}) != nullptr);
+  }
+}
+
+TEST_CASE("loader: loading the same file twice is a no-op") {
+  tsi::Registry r;
+  tsi::PluginLoader loader(r);
+  loader.load(fixture("good"));
+  CHECK_NOTHROW(loader.load(fixture("good")));
+  CHECK(r.models().size() == 1);
+  CHECK(r.schemes().size() == 1);
+}
+
+TEST_CASE("loader: a plugin for another ABI is refused") {
+  expect_refused(fixture("wrong_abi"), "built for plugin ABI 999, this tsi speaks ABI 1");
+}
+
+TEST_CASE("loader: a plugin for another tsi major version is refused") {
+  expect_refused(fixture("wrong_major"), "built for tsi 99.0.0, this is tsi " + std::string(tsi::version_string));
+}
+
+TEST_CASE("loader: a library without the entry point is refused") {
+  const std::string path = fixture("no_entry");
+  expect_refused(path, path + ": not a tsi plugin (no entry point tsi_plugin_entry)");
+}
+
+TEST_CASE("loader: a throwing registration is rolled back") {
+  const std::string path = fixture("throws");
+  expect_refused(path, path + ": registration failed: boom");
+}
+
+TEST_CASE("loader: a missing file is refused") {
+  expect_refused("/nonexistent/tsi_nothing.so", "/nonexistent/tsi_nothing.so: no such file");
+}
+
+TEST_CASE("loader: a duplicate name names both providers and rolls back") {
+  tsi::Registry r;
+  tsi::PluginLoader loader(r);
+  const std::string good = fixture("good"), dup = fixture("duplicate");
+  loader.load(good);
+  const std::size_t before = size(r);
+  const std::string clash =
+      "model \"fixture-model\" is already registered by " + good + " (while registering from " + dup + ")";
+  CHECK_THROWS_WITH_AS(loader.load(dup), doctest::Contains(clash.c_str()), tsi::PluginError);
+  CHECK(size(r) == before);
+  CHECK_THROWS_AS(r.scheme("fixture-duplicate-scheme"), tsi::ConfigError);
+  CHECK(r.model("fixture-model").info.provider == good);
+  CHECK(r.provider() == "core");
+}
+
+TEST_CASE("loader: a directory scan collects failures without throwing") {
+  tsi::Registry r;
+  tsi::PluginLoader loader(r);
+  std::vector<tsi::PluginLoadReport> reports;
+  CHECK_NOTHROW(reports = loader.load_directory(TSI_TEST_FIXTURE_DIR));
+  // Sorted: duplicate loads first into the empty registry, so good then clashes with it.
+  std::vector<std::string> expected;
+  for (const char* n : {"duplicate", "good", "no_entry", "throws", "wrong_abi", "wrong_major"}) {
+    expected.push_back(fixture(n));
+  }
+  REQUIRE(reports.size() == expected.size());
+  for (std::size_t i = 0; i < reports.size(); ++i) {
+    CAPTURE(reports[i].path);
+    CHECK(reports[i].path == expected[i]);
+    CHECK(reports[i].ok == (i == 0));
+    CHECK(reports[i].error.empty() == (i == 0));
+  }
+  CHECK(reports[1].error.find("already registered") != std::string::npos);
+  CHECK(r.scheme("fixture-duplicate-scheme").info.provider == expected[0]);
+  CHECK(loader.reports().size() == reports.size());
+}
+
+TEST_CASE("loader: a missing directory yields no reports") {
+  tsi::Registry r;
+  tsi::PluginLoader loader(r);
+  CHECK(loader.load_directory("/nonexistent/plugins").empty());
+}
+
+TEST_CASE("loader: a path list loads files and collects failures") {
+  tsi::Registry r;
+  tsi::PluginLoader loader(r);
+  const auto reports = loader.load_path_list(fixture("good") + "::/nonexistent/tsi_x.so:" + fixture("throws"));
+  REQUIRE(reports.size() == 3);
+  CHECK(reports[0].ok);
+  CHECK_FALSE(reports[1].ok);
+  CHECK_FALSE(reports[2].ok);
+  CHECK(r.model("fm").info.provider == fixture("good"));
+}
+
+TEST_CASE("loader: the default directory is known") { CHECK_FALSE(tsi::PluginLoader::default_directory().empty()); }
