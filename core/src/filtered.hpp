@@ -1,4 +1,5 @@
 #pragma once
+#include "tsi/phase.hpp"
 #include "tsi/reformulation.hpp"
 
 namespace tsi {
@@ -12,6 +13,7 @@ class Filtered final : public Reformulation {
   Index size() const override { return model_->dim(); }
   const Vector& linear_multipliers() const override { return zeros_; }
   bool autonomous() const override { return false; }
+  double fast_period() const override { return two_pi * model_->eps(); }
   void nonlinear(double t, const Vector& y, Vector& out) override;
   void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
   void rhs(double t, const Vector& y, Vector& out) override { nonlinear(t, y, out); }

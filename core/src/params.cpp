@@ -31,11 +31,16 @@ bool integral_float(const Json& v) {
 
 bool has_type(ParamType type, const Json& v) {
   switch (type) {
-    case ParamType::Number: return v.is_number();
-    case ParamType::Integer: return v.is_number_integer() || integral_float(v);
-    case ParamType::Boolean: return v.is_boolean();
-    case ParamType::String: return v.is_string();
-    case ParamType::Array: return v.is_array();
+    case ParamType::Number:
+      return v.is_number();
+    case ParamType::Integer:
+      return v.is_number_integer() || integral_float(v);
+    case ParamType::Boolean:
+      return v.is_boolean();
+    case ParamType::String:
+      return v.is_string();
+    case ParamType::Array:
+      return v.is_array();
   }
   return false;
 }
@@ -53,11 +58,16 @@ ParamSpec make_spec(std::string name, ParamType type, Json default_value, std::s
 
 std::string describe(ParamType type) {
   switch (type) {
-    case ParamType::Number: return "a number";
-    case ParamType::Integer: return "an integer";
-    case ParamType::Boolean: return "a boolean";
-    case ParamType::String: return "a string";
-    case ParamType::Array: return "an array";
+    case ParamType::Number:
+      return "a number";
+    case ParamType::Integer:
+      return "an integer";
+    case ParamType::Boolean:
+      return "a boolean";
+    case ParamType::String:
+      return "a string";
+    case ParamType::Array:
+      return "an array";
   }
   return "a value";
 }
@@ -89,25 +99,30 @@ ParamSpec& ParamSpec::check(std::function<bool(const Json&)> predicate, std::str
 ParamSpec& ParamSpec::choices(std::vector<std::string> names) {
   expected = "one of: " + join(names);
   valid = [names = std::move(names)](const Json& v) {
-    return v.is_string() && std::find(names.begin(), names.end(), v.get<std::string>()) != names.end();
+    return v.is_string() &&
+           std::find(names.begin(), names.end(), v.get<std::string>()) != names.end();
   };
   return *this;
 }
 
 ParamSpec number_param(std::string name, Json default_value, std::string description) {
-  return make_spec(std::move(name), ParamType::Number, std::move(default_value), std::move(description));
+  return make_spec(std::move(name), ParamType::Number, std::move(default_value),
+                   std::move(description));
 }
 
 ParamSpec integer_param(std::string name, Json default_value, std::string description) {
-  return make_spec(std::move(name), ParamType::Integer, std::move(default_value), std::move(description));
+  return make_spec(std::move(name), ParamType::Integer, std::move(default_value),
+                   std::move(description));
 }
 
 ParamSpec bool_param(std::string name, Json default_value, std::string description) {
-  return make_spec(std::move(name), ParamType::Boolean, std::move(default_value), std::move(description));
+  return make_spec(std::move(name), ParamType::Boolean, std::move(default_value),
+                   std::move(description));
 }
 
 ParamSpec string_param(std::string name, Json default_value, std::string description) {
-  return make_spec(std::move(name), ParamType::String, std::move(default_value), std::move(description));
+  return make_spec(std::move(name), ParamType::String, std::move(default_value),
+                   std::move(description));
 }
 
 ParamSpec array_param(std::string name, std::string description) {
@@ -117,7 +132,8 @@ ParamSpec array_param(std::string name, std::string description) {
 Json resolve_params(const ParamSchema& schema, const Json& given, const std::string& path) {
   if (!given.is_object()) throw ConfigError(path, "expected an object, got " + given.dump());
   const auto find = [&schema](const std::string& key) {
-    return std::find_if(schema.begin(), schema.end(), [&key](const ParamSpec& s) { return s.name == key; });
+    return std::find_if(schema.begin(), schema.end(),
+                        [&key](const ParamSpec& s) { return s.name == key; });
   };
   Json out = Json::object();
   for (const auto& [key, value] : given.items()) {

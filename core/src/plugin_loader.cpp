@@ -33,7 +33,9 @@ void keep_handle(void* handle) {
 /// True when `registry` already holds something registered from `provider`.
 bool provides(const Registry& registry, const std::string& provider) {
   const auto from = [&provider](const auto* e) { return e->info.provider == provider; };
-  const auto any = [&from](const auto& entries) { return std::any_of(entries.begin(), entries.end(), from); };
+  const auto any = [&from](const auto& entries) {
+    return std::any_of(entries.begin(), entries.end(), from);
+  };
   return any(registry.models()) || any(registry.reformulations()) || any(registry.schemes());
 }
 
@@ -47,7 +49,8 @@ const TsiPluginInfo& open_plugin(const std::string& path) {
   }
   keep_handle(handle);
   void* symbol = dlsym(handle, TSI_PLUGIN_ENTRY_NAME);
-  if (!symbol) throw PluginError(path + ": not a tsi plugin (no entry point " TSI_PLUGIN_ENTRY_NAME ")");
+  if (!symbol)
+    throw PluginError(path + ": not a tsi plugin (no entry point " TSI_PLUGIN_ENTRY_NAME ")");
   EntryFn entry = nullptr;
   std::memcpy(&entry, &symbol, sizeof entry);
   const TsiPluginInfo* info = entry();
@@ -61,7 +64,8 @@ const TsiPluginInfo& open_plugin(const std::string& path) {
                       " bytes, this tsi expects " + std::to_string(sizeof(TsiPluginInfo)));
   }
   if (info->tsi_version_major != version_major) {
-    const std::string theirs = info->tsi_version ? info->tsi_version : std::to_string(info->tsi_version_major);
+    const std::string theirs =
+        info->tsi_version ? info->tsi_version : std::to_string(info->tsi_version_major);
     throw PluginError(path + ": built for tsi " + theirs + ", this is tsi " + version_string +
                       " (major versions differ)");
   }

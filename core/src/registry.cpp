@@ -37,9 +37,10 @@ struct Table {
   void check_free(const std::string& key, const std::string& provider) const {
     const Entry* taken = find(key);
     if (!taken) return;
-    const std::string as = taken->info.name == key ? "" : " as an alias of " + quoted(taken->info.name);
-    throw PluginError(kind + " " + quoted(key) + " is already registered by " + taken->info.provider +
-                      as + " (while registering from " + provider + ")");
+    const std::string as =
+        taken->info.name == key ? "" : " as an alias of " + quoted(taken->info.name);
+    throw PluginError(kind + " " + quoted(key) + " is already registered by " +
+                      taken->info.provider + as + " (while registering from " + provider + ")");
   }
 
   void add(Entry entry, const std::string& provider) {
@@ -55,14 +56,15 @@ struct Table {
 
   const Entry& get(const std::string& key, const std::string& field) const {
     if (const Entry* e = find(key)) return *e;
-    if (entries.empty()) throw ConfigError(field, "unknown " + kind + " " + quoted(key) + "; no " + plural + " are registered");
+    const std::string unknown = "unknown " + kind + " " + quoted(key) + "; ";
+    if (entries.empty()) throw ConfigError(field, unknown + "no " + plural + " are registered");
     std::string list;
     for (const auto& [name, e] : entries) {
       list += (list.empty() ? "" : ", ") + name;
       const auto& a = e.info.aliases;
       if (!a.empty()) list += (a.size() == 1 ? " (alias: " : " (aliases: ") + join(a) + ")";
     }
-    throw ConfigError(field, "unknown " + kind + " " + quoted(key) + "; valid " + plural + " are: " + list);
+    throw ConfigError(field, unknown + "valid " + plural + " are: " + list);
   }
 
   std::vector<const Entry*> sorted() const {
@@ -78,7 +80,8 @@ struct Table {
 };
 
 bool has_param(const ParamSchema& schema, const std::string& name) {
-  return std::any_of(schema.begin(), schema.end(), [&](const ParamSpec& s) { return s.name == name; });
+  return std::any_of(schema.begin(), schema.end(),
+                     [&](const ParamSpec& s) { return s.name == name; });
 }
 
 }  // namespace
@@ -101,11 +104,13 @@ Registry::~Registry() = default;
 void Registry::add_model(ModelEntry entry) {
   auto& params = entry.info.params;
   if (!has_param(params, "eps")) {
-    params.push_back(number_param("eps", 0.01, "the small parameter: stiffness 1/eps of the linear part")
-                         .range(0.0, 1.0, true, false));
+    params.push_back(
+        number_param("eps", 0.01, "the small parameter: stiffness 1/eps of the linear part")
+            .range(0.0, 1.0, true, false));
   }
   if (!has_param(params, "u0")) {
-    params.push_back(array_param("u0", "initial value in physical variables; default: the model's own"));
+    params.push_back(
+        array_param("u0", "initial value in physical variables; default: the model's own"));
   }
   impl_->models.add(std::move(entry), impl_->provider);
 }
@@ -114,13 +119,16 @@ void Registry::add_reformulation(ReformulationEntry entry) {
   impl_->reformulations.add(std::move(entry), impl_->provider);
 }
 
-void Registry::add_scheme(SchemeEntry entry) { impl_->schemes.add(std::move(entry), impl_->provider); }
+void Registry::add_scheme(SchemeEntry entry) {
+  impl_->schemes.add(std::move(entry), impl_->provider);
+}
 
 const ModelEntry& Registry::model(const std::string& name, const std::string& field) const {
   return impl_->models.get(name, field);
 }
 
-const ReformulationEntry& Registry::reformulation(const std::string& name, const std::string& field) const {
+const ReformulationEntry& Registry::reformulation(const std::string& name,
+                                                  const std::string& field) const {
   return impl_->reformulations.get(name, field);
 }
 
@@ -136,17 +144,20 @@ std::vector<const ReformulationEntry*> Registry::reformulations() const {
 
 std::vector<const SchemeEntry*> Registry::schemes() const { return impl_->schemes.sorted(); }
 
-void Registry::check_compatible(const SchemeEntry& scheme, const ReformulationEntry& reformulation) const {
+void Registry::check_compatible(const SchemeEntry& scheme,
+                                const ReformulationEntry& reformulation) const {
   auto names = scheme.traits.reformulations;
   const auto supports = [&names](const std::string& n) {
     return std::find(names.begin(), names.end(), n) != names.end();
   };
   const auto& info = reformulation.info;
-  if (supports(info.name) || std::any_of(info.aliases.begin(), info.aliases.end(), supports)) return;
+  if (supports(info.name) || std::any_of(info.aliases.begin(), info.aliases.end(), supports))
+    return;
   std::sort(names.begin(), names.end());
-  throw ConfigError("reformulation.name",
-                    "scheme " + quoted(scheme.info.name) + " cannot integrate the " + quoted(info.name) +
-                        " reformulation; compatible reformulations: " + (names.empty() ? "none" : join(names)));
+  throw ConfigError(
+      "reformulation.name",
+      "scheme " + quoted(scheme.info.name) + " cannot integrate the " + quoted(info.name) +
+          " reformulation; compatible reformulations: " + (names.empty() ? "none" : join(names)));
 }
 
 void Registry::set_provider(std::string provider) { impl_->provider = std::move(provider); }

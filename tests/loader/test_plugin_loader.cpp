@@ -51,7 +51,8 @@ TEST_CASE("loader: a good plugin registers its names under its own path") {
   CHECK(loader.reports()[0].name == "fixture-good");
 
   SUBCASE("its factories work") {
-    tsi::Params params(tsi::resolve_params(r.model("fm").info.params, tsi::Json{{"eps", 0.5}}, "model"));
+    tsi::Params params(
+        tsi::resolve_params(r.model("fm").info.params, tsi::Json{{"eps", 0.5}}, "model"));
     auto model = r.model("fm").create(params);
     REQUIRE(model);
     CHECK(model->eps() == doctest::Approx(0.5));
@@ -74,7 +75,8 @@ TEST_CASE("loader: a plugin for another ABI is refused") {
 }
 
 TEST_CASE("loader: a plugin for another tsi major version is refused") {
-  expect_refused(fixture("wrong_major"), "built for tsi 99.0.0, this is tsi " + std::string(tsi::version_string));
+  expect_refused(fixture("wrong_major"),
+                 "built for tsi 99.0.0, this is tsi " + std::string(tsi::version_string));
 }
 
 TEST_CASE("loader: a library without the entry point is refused") {
@@ -97,8 +99,8 @@ TEST_CASE("loader: a duplicate name names both providers and rolls back") {
   const std::string good = fixture("good"), dup = fixture("duplicate");
   loader.load(good);
   const std::size_t before = size(r);
-  const std::string clash =
-      "model \"fixture-model\" is already registered by " + good + " (while registering from " + dup + ")";
+  const std::string clash = "model \"fixture-model\" is already registered by " + good +
+                            " (while registering from " + dup + ")";
   CHECK_THROWS_WITH_AS(loader.load(dup), doctest::Contains(clash.c_str()), tsi::PluginError);
   CHECK(size(r) == before);
   CHECK_THROWS_AS(r.scheme("fixture-duplicate-scheme"), tsi::ConfigError);
@@ -137,7 +139,8 @@ TEST_CASE("loader: a missing directory yields no reports") {
 TEST_CASE("loader: a path list loads files and collects failures") {
   tsi::Registry r;
   tsi::PluginLoader loader(r);
-  const auto reports = loader.load_path_list(fixture("good") + "::/nonexistent/tsi_x.so:" + fixture("throws"));
+  const auto reports =
+      loader.load_path_list(fixture("good") + "::/nonexistent/tsi_x.so:" + fixture("throws"));
   REQUIRE(reports.size() == 3);
   CHECK(reports[0].ok);
   CHECK_FALSE(reports[1].ok);
@@ -145,4 +148,6 @@ TEST_CASE("loader: a path list loads files and collects failures") {
   CHECK(r.model("fm").info.provider == fixture("good"));
 }
 
-TEST_CASE("loader: the default directory is known") { CHECK_FALSE(tsi::PluginLoader::default_directory().empty()); }
+TEST_CASE("loader: the default directory is known") {
+  CHECK_FALSE(tsi::PluginLoader::default_directory().empty());
+}

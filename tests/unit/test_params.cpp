@@ -10,11 +10,12 @@ using tsi::Json;
 namespace {
 
 tsi::ParamSchema schema() {
-  return {tsi::number_param("eps", 0.01, "small parameter").range(0.0, 1.0, true, false),
-          tsi::integer_param("n", 64, "resolution").range(4, std::numeric_limits<double>::infinity()),
-          tsi::bool_param("verbose", false, "chatty"),
-          tsi::string_param("mode", "fast", "how").choices({"fast", "slow"}),
-          tsi::array_param("u0", "initial value")};
+  return {
+      tsi::number_param("eps", 0.01, "small parameter").range(0.0, 1.0, true, false),
+      tsi::integer_param("n", 64, "resolution").range(4, std::numeric_limits<double>::infinity()),
+      tsi::bool_param("verbose", false, "chatty"),
+      tsi::string_param("mode", "fast", "how").choices({"fast", "slow"}),
+      tsi::array_param("u0", "initial value")};
 }
 
 /// The message of the ConfigError that resolving `given` throws.
@@ -65,7 +66,8 @@ TEST_CASE("params: an unknown key is rejected with the sorted list of valid keys
 }
 
 TEST_CASE("params: wrong types name the field, the value and what was expected") {
-  CHECK(error_of(Json{{"eps", "small"}}) == "model.eps: got \"small\", expected a number in (0, 1]");
+  CHECK(error_of(Json{{"eps", "small"}}) ==
+        "model.eps: got \"small\", expected a number in (0, 1]");
   CHECK(error_of(Json{{"verbose", 1}}) == "model.verbose: got 1, expected a boolean");
   CHECK(error_of(Json{{"u0", 1.0}}) == "model.u0: got 1.0, expected an array");
   CHECK(error_of(Json{{"n", 4.5}}) == "model.n: got 4.5, expected an integer in [4, inf)");
@@ -76,7 +78,8 @@ TEST_CASE("params: out-of-range values are rejected") {
   CHECK(error_of(Json{{"eps", 2}}) == "model.eps: got 2, expected a number in (0, 1]");
   CHECK(error_of(Json{{"eps", 0.0}}) == "model.eps: got 0.0, expected a number in (0, 1]");
   CHECK(error_of(Json{{"n", 2}}) == "model.n: got 2, expected an integer in [4, inf)");
-  CHECK(error_of(Json{{"mode", "medium"}}) == "model.mode: got \"medium\", expected one of: fast, slow");
+  CHECK(error_of(Json{{"mode", "medium"}}) ==
+        "model.mode: got \"medium\", expected one of: fast, slow");
 }
 
 TEST_CASE("params: an integer-valued float is accepted as an integer") {
@@ -90,10 +93,11 @@ TEST_CASE("params: the section itself must be an object") {
 }
 
 TEST_CASE("params: check() and describe()") {
-  tsi::ParamSchema s{tsi::number_param("x", 1.0, "").check(
-      [](const Json& v) { return v.get<double>() != 0.0; }, "a nonzero number")};
-  CHECK_THROWS_WITH_AS(tsi::resolve_params(s, Json{{"x", 0}}, "a.b"), "a.b.x: got 0, expected a nonzero number",
-                       tsi::ConfigError);
+  tsi::ParamSchema s{
+      tsi::number_param("x", 1.0, "")
+          .check([](const Json& v) { return v.get<double>() != 0.0; }, "a nonzero number")};
+  CHECK_THROWS_WITH_AS(tsi::resolve_params(s, Json{{"x", 0}}, "a.b"),
+                       "a.b.x: got 0, expected a nonzero number", tsi::ConfigError);
   CHECK(tsi::resolve_params(s, Json{{"x", -2}}, "a.b")["x"] == -2);
   CHECK(tsi::describe(tsi::ParamType::Integer) == "an integer");
 }

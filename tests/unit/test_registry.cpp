@@ -28,7 +28,8 @@ tsi::SchemeEntry scheme(std::string name, std::vector<std::string> reformulation
 }
 
 bool has_param(const tsi::ParamSchema& schema, const std::string& name) {
-  return std::any_of(schema.begin(), schema.end(), [&](const tsi::ParamSpec& s) { return s.name == name; });
+  return std::any_of(schema.begin(), schema.end(),
+                     [&](const tsi::ParamSpec& s) { return s.name == name; });
 }
 
 }  // namespace
@@ -50,10 +51,11 @@ TEST_CASE("registry: a miss lists the valid names, sorted, with their aliases") 
   tsi::Registry r;
   r.add_model(model("henon-heiles", {"hh"}));
   r.add_model(model("cpd", {"charged-particle"}));
-  CHECK_THROWS_WITH_AS(r.model("foo"),
-                       "model.name: unknown model \"foo\"; valid models are: cpd (alias: charged-particle), "
-                       "henon-heiles (alias: hh)",
-                       tsi::ConfigError);
+  CHECK_THROWS_WITH_AS(
+      r.model("foo"),
+      "model.name: unknown model \"foo\"; valid models are: cpd (alias: charged-particle), "
+      "henon-heiles (alias: hh)",
+      tsi::ConfigError);
   try {
     r.scheme("x", "run.scheme");
   } catch (const tsi::ConfigError& e) {
@@ -67,10 +69,12 @@ TEST_CASE("registry: names and aliases are unique within a kind") {
   r.add_scheme(scheme("se1", {"two-scale"}));
   r.add_model(model("henon-heiles", {"hh"}));
   r.set_provider("/p/other.so");
-  CHECK_THROWS_WITH_AS(r.add_scheme(scheme("se1", {})),
-                       "scheme \"se1\" is already registered by /p/tsi_a.so (while registering from /p/other.so)",
+  CHECK_THROWS_WITH_AS(
+      r.add_scheme(scheme("se1", {})),
+      "scheme \"se1\" is already registered by /p/tsi_a.so (while registering from /p/other.so)",
+      tsi::PluginError);
+  CHECK_THROWS_WITH_AS(r.add_model(model("hh")), doctest::Contains("alias of \"henon-heiles\""),
                        tsi::PluginError);
-  CHECK_THROWS_WITH_AS(r.add_model(model("hh")), doctest::Contains("alias of \"henon-heiles\""), tsi::PluginError);
   CHECK_THROWS_AS(r.add_model(model("new", {"henon-heiles"})), tsi::PluginError);
   CHECK(r.models().size() == 1);
   r.add_model(model("se1"));  // another kind: no clash
@@ -84,15 +88,18 @@ TEST_CASE("registry: every model gets eps and u0") {
   r.add_model(std::move(e));
   const auto& params = r.model("m").info.params;
   CHECK(has_param(params, "u0"));
-  CHECK(std::count_if(params.begin(), params.end(), [](const auto& s) { return s.name == "eps"; }) == 1);
+  CHECK(std::count_if(params.begin(), params.end(),
+                      [](const auto& s) { return s.name == "eps"; }) == 1);
   CHECK(params[0].default_value == 0.5);
 
   r.add_model(model("plain"));
-  const auto resolved = tsi::resolve_params(r.model("plain").info.params, tsi::Json::object(), "model");
+  const auto resolved =
+      tsi::resolve_params(r.model("plain").info.params, tsi::Json::object(), "model");
   CHECK(resolved["eps"] == 0.01);
   CHECK(resolved["u0"].is_null());
-  CHECK_THROWS_WITH_AS(tsi::resolve_params(r.model("plain").info.params, tsi::Json{{"eps", 2}}, "model"),
-                       "model.eps: got 2, expected a number in (0, 1]", tsi::ConfigError);
+  CHECK_THROWS_WITH_AS(
+      tsi::resolve_params(r.model("plain").info.params, tsi::Json{{"eps", 2}}, "model"),
+      "model.eps: got 2, expected a number in (0, 1]", tsi::ConfigError);
 }
 
 TEST_CASE("registry: check_compatible names the compatible reformulations") {
@@ -101,10 +108,11 @@ TEST_CASE("registry: check_compatible names the compatible reformulations") {
   r.add_reformulation(reformulation("direct"));
   r.add_scheme(scheme("rk78", {"filtered", "direct"}));
   CHECK_NOTHROW(r.check_compatible(r.scheme("rk78"), r.reformulation("direct")));
-  CHECK_THROWS_WITH_AS(r.check_compatible(r.scheme("rk78"), r.reformulation("two-scale")),
-                       "reformulation.name: scheme \"rk78\" cannot integrate the \"two-scale\" reformulation; "
-                       "compatible reformulations: direct, filtered",
-                       tsi::ConfigError);
+  CHECK_THROWS_WITH_AS(
+      r.check_compatible(r.scheme("rk78"), r.reformulation("two-scale")),
+      "reformulation.name: scheme \"rk78\" cannot integrate the \"two-scale\" reformulation; "
+      "compatible reformulations: direct, filtered",
+      tsi::ConfigError);
 }
 
 TEST_CASE("registry: remove_provider removes exactly that provider's entries") {
@@ -123,4 +131,6 @@ TEST_CASE("registry: remove_provider removes exactly that provider's entries") {
   CHECK(r.model("xm").info.provider == "core");
 }
 
-TEST_CASE("registry: global() is one instance") { CHECK(&tsi::Registry::global() == &tsi::Registry::global()); }
+TEST_CASE("registry: global() is one instance") {
+  CHECK(&tsi::Registry::global() == &tsi::Registry::global());
+}

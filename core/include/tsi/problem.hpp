@@ -19,6 +19,9 @@ class TSI_API Problem {
   bool has_diagonal_linear_part() const { return linear_multipliers().size() == size(); }
   /// True when N does not depend on t.
   virtual bool autonomous() const = 0;
+  /// The period in t of the explicit time dependence (filtered: 2 pi eps), 0 if none.
+  /// Adaptive solvers must not step across it: their error estimates alias.
+  virtual double fast_period() const { return 0.0; }
 
   /// out = N(t, y).
   virtual void nonlinear(double t, const Vector& y, Vector& out) = 0;
