@@ -92,24 +92,26 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   csv = "t,H,I,m,err_H,err_I,err_m,tau_roughness\n";
   const auto start = Clock::now();
   long steps_done = 0;
+  // Construction: bad input (a model's own checks, u0 of the wrong shape) is a ConfigError
+  // that propagates before anything runs.
+  const ModelEntry& model_entry = registry.model(config["model"]["name"]);
+  const SchemeEntry& scheme_entry = registry.scheme(config["scheme"]["name"]);
+  const ReformulationEntry& reform_entry = registry.reformulation(config["reformulation"]["name"]);
+  std::shared_ptr<const Model> model = model_entry.create(Params(without_name(config["model"])));
+  const Vector u0 = initial_value(*model, config["model"]);
+  auto reformulation = reform_entry.create(model, Params(without_name(config["reformulation"])));
+  auto stepper = scheme_entry.create(Params(without_name(config["scheme"])));
+
+  const auto& rconf = config["reformulation"];
+  if (rconf.contains("initial_data_order") &&
+      rconf["initial_data_order"].get<int>() < scheme_entry.traits.initial_data_order) {
+    result["warnings"].push_back(fmt::format(
+        "scheme \"{}\" needs prepared data of order {} for uniform accuracy; running with order {}",
+        scheme_entry.info.name, scheme_entry.traits.initial_data_order,
+        rconf["initial_data_order"].get<int>()));
+  }
+
   try {
-    const ModelEntry& model_entry = registry.model(config["model"]["name"]);
-    const SchemeEntry& scheme_entry = registry.scheme(config["scheme"]["name"]);
-    const ReformulationEntry& reform_entry = registry.reformulation(config["reformulation"]["name"]);
-    std::shared_ptr<const Model> model = model_entry.create(Params(without_name(config["model"])));
-    auto reformulation = reform_entry.create(model, Params(without_name(config["reformulation"])));
-    auto stepper = scheme_entry.create(Params(without_name(config["scheme"])));
-
-    const auto& rconf = config["reformulation"];
-    if (rconf.contains("initial_data_order") &&
-        rconf["initial_data_order"].get<int>() < scheme_entry.traits.initial_data_order) {
-      result["warnings"].push_back(fmt::format(
-          "scheme \"{}\" needs prepared data of order {} for uniform accuracy; running with order {}",
-          scheme_entry.info.name, scheme_entry.traits.initial_data_order,
-          rconf["initial_data_order"].get<int>()));
-    }
-
-    const Vector u0 = initial_value(*model, config["model"]);
     const double h = config["time"]["h"], t_end = config["time"]["t_end"];
     const long n_steps = step_count(config);
     const long every = config["output"]["every"];

@@ -1,0 +1,217 @@
+// `tsi list`: what the runner knows, as text and as JSON, and its usage errors.
+#include <doctest/doctest.h>
+
+#include <string>
+
+#include "run_command.hpp"
+
+namespace {
+
+using namespace tsi::test;
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+bool ends_with(const std::string& text, const std::string& tail) { return text.ends_with(tail); }
+
+/// The entry called `name` in a list of entries, or null.
+Json entry_named(const Json& entries, const std::string& name) {
+  for (const auto& e : entries)
+    if (e.at("name") == name) return e;
+  return nullptr;
+}
+
+/// The parameter called `name` in an entry's params, or null.
+Json param_named(const Json& entry, const std::string& name) { return entry_named(entry.at("params"), name); }
+
+bool has_string(const Json& list, const std::string& s) {
+  for (const auto& x : list)
+    if (x == s) return true;
+  return false;
+}
+
+Json list_json(const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> args = {"list"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  args.push_back("--json");
+  const CommandResult r = run_tsi(args);
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  return Json::parse(r.out);
+}
+
+}  // namespace
+
+TEST_SUITE("tsi_runner_tests") {
+
+TEST_CASE("list --json: models, reformulations and schemes") {
+  const Json all = list_json();
+  INFO(all.dump(2));
+  REQUIRE(all.at("models").is_array());
+  REQUIRE(all.at("reformulations").is_array());
+  REQUIRE(all.at("schemes").is_array());
+
+  SUBCASE("henon-heiles comes from its plugin with eps and u0 parameters") {
+    const Json hh = entry_named(all.at("models"), "henon-heiles");
+    REQUIRE(hh.is_object());
+    CHECK(ends_with(hh.at("provider").get<std::string>(), "tsi_henon_heiles.so"));
+    CHECK(has_string(hh.at("aliases"), "hh"));
+    CHECK(hh.at("default_n_tau") == 64);
+    CHECK_FALSE(hh.at("summary").get<std::string>().empty());
+    const Json eps = param_named(hh, "eps");
+    REQUIRE(eps.is_object());
+    CHECK(eps.at("default").get<double>() == doctest::Approx(0.01));
+    CHECK(eps.at("type") == "a number");
+    CHECK(contains(eps.at("expected").get<std::string>(), "(0, 1]"));
+    const Json u0 = param_named(hh, "u0");
+    REQUIRE(u0.is_object());
+    CHECK(u0.at("default").is_null());
+  }
+
+  SUBCASE("se1 and rk78 with their parameters and traits") {
+    const Json se1 = entry_named(all.at("schemes"), "se1");
+    REQUIRE(se1.is_object());
+    CHECK(ends_with(se1.at("provider").get<std::string>(), "tsi_se1.so"));
+    CHECK(has_string(se1.at("aliases"), "se1-tsi"));
+    REQUIRE(param_named(se1, "tol").is_object());
+    CHECK(param_named(se1, "tol").at("default").get<double>() == doctest::Approx(1e-10));
+    REQUIRE(param_named(se1, "max_iter").is_object());
+    CHECK(param_named(se1, "max_iter").at("default") == 200);
+    CHECK(param_named(se1, "max_iter").at("type") == "an integer");
+    const Json& t = se1.at("traits");
+    CHECK(t.at("order") == 2);
+    CHECK(t.at("symmetric") == true);
+    CHECK(t.at("implicit") == true);
+    CHECK(t.at("initial_data_order") == 2);
+    CHECK(has_string(t.at("reformulations"), "two-scale"));
+    CHECK(has_string(t.at("reformulations"), "filtered"));
+
+    const Json rk78 = entry_named(all.at("schemes"), "rk78");
+    REQUIRE(rk78.is_object());
+    CHECK(ends_with(rk78.at("provider").get<std::string>(), "tsi_rk78.so"));
+    REQUIRE(param_named(rk78, "tol").is_object());
+    CHECK(param_named(rk78, "tol").at("default").get<double>() == doctest::Approx(1e-10));
+    CHECK(rk78.at("traits").at("adaptive") == true);
+    CHECK(has_string(rk78.at("traits").at("reformulations"), "direct"));
+    CHECK(has_string(rk78.at("traits").at("reformulations"), "filtered"));
+    CHECK_FALSE(has_string(rk78.at("traits").at("reformulations"), "two-scale"));
+  }
+
+  SUBCASE("the core reformulations") {
+    for (const char* name : {"two-scale", "filtered", "direct"}) {
+      INFO("reformulation " << name);
+      const Json r = entry_named(all.at("reformulations"), name);
+      REQUIRE(r.is_object());
+      CHECK(r.at("provider") == "core");
+      CHECK(r.at("params").is_array());
+    }
+    const Json two_scale = entry_named(all.at("reformulations"), "two-scale");
+    const Json n_tau = param_named(two_scale, "n_tau");
+    REQUIRE(n_tau.is_object());
+    CHECK(n_tau.at("default").is_null());  // the model's own
+    CHECK(n_tau.at("type") == "an integer");
+    CHECK(contains(n_tau.at("expected").get<std::string>(), "even"));
+    REQUIRE(param_named(two_scale, "initial_data_order").is_object());
+  }
+
+  SUBCASE("entries are sorted by name") {
+    for (const char* kind : {"models", "reformulations", "schemes"}) {
+      INFO(kind);
+      const Json& entries = all.at(kind);
+      for (std::size_t i = 1; i < entries.size(); ++i)
+        CHECK(entries[i - 1].at("name").get<std::string>() < entries[i].at("name").get<std::string>());
+    }
+  }
+}
+
+TEST_CASE("list --json: one kind at a time") {
+  SUBCASE("models") {
+    const Json j = list_json({"models"});
+    CHECK(j.contains("models"));
+    CHECK_FALSE(j.contains("reformulations"));
+    CHECK_FALSE(j.contains("schemes"));
+  }
+  SUBCASE("reformulations") {
+    const Json j = list_json({"reformulations"});
+    CHECK(j.contains("reformulations"));
+    CHECK_FALSE(j.contains("models"));
+    CHECK_FALSE(j.contains("schemes"));
+  }
+  SUBCASE("schemes") {
+    const Json j = list_json({"schemes"});
+    CHECK(j.contains("schemes"));
+    CHECK_FALSE(j.contains("models"));
+    CHECK_FALSE(j.contains("reformulations"));
+  }
+}
+
+TEST_CASE("list: the text form names every entry and its provider") {
+  const CommandResult r = run_tsi({"list"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  for (const char* part : {"models:", "reformulations:", "schemes:", "henon-heiles (hh)", "se1 (se1-tsi)", "rk78",
+                           "two-scale", "filtered", "direct", "provided by", "tsi_henon_heiles.so", "max_iter"})
+    CHECK_MESSAGE(contains(r.out, part), "missing: " << part);
+}
+
+TEST_CASE("list: the text form of one kind") {
+  const CommandResult r = run_tsi({"list", "schemes"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  CHECK(contains(r.out, "schemes:"));
+  CHECK(contains(r.out, "se1"));
+  CHECK_FALSE(contains(r.out, "models:"));
+  CHECK_FALSE(contains(r.out, "henon-heiles"));
+}
+
+TEST_CASE("list: an unknown kind is bad input") {
+  for (const bool json : {false, true}) {
+    INFO("--json " << json);
+    std::vector<std::string> args = {"list", "bogus"};
+    if (json) args.push_back("--json");
+    const CommandResult r = run_tsi(args);
+    INFO(r.describe());
+    CHECK(r.signal == 0);
+    CHECK(r.exit_code == 2);
+    CHECK(contains(r.err, "tsi: error: list:"));
+    CHECK(contains(r.err, "\"bogus\""));
+    CHECK(contains(r.err, "models, reformulations or schemes"));
+    CHECK(r.out.empty());
+  }
+}
+
+TEST_CASE("cli: no command is a usage error and --version and --help succeed") {
+  SUBCASE("no command") {
+    const CommandResult r = run_tsi({});
+    INFO(r.describe());
+    CHECK(r.signal == 0);
+    CHECK(r.exit_code == 2);
+  }
+  SUBCASE("unknown command") {
+    const CommandResult r = run_tsi({"frobnicate"});
+    INFO(r.describe());
+    CHECK(r.signal == 0);
+    CHECK(r.exit_code == 2);
+  }
+  SUBCASE("--version") {
+    const CommandResult r = run_tsi({"--version"});
+    INFO(r.describe());
+    CHECK(r.exit_code == 0);
+    CHECK_FALSE(r.out.empty());
+    // the same version that a run records in result.json
+    TempDir dir;
+    const CommandResult run = run_tsi({"run", write_config(dir, small_config()), "--out", dir / "out"});
+    INFO(run.describe());
+    REQUIRE(run.exit_code == 0);
+    const std::string version = read_json(dir.path() / "out" / "result.json").at("tsi_version");
+    CHECK(contains(r.out, version));
+  }
+  SUBCASE("--help") {
+    const CommandResult r = run_tsi({"--help"});
+    INFO(r.describe());
+    CHECK(r.exit_code == 0);
+    CHECK(contains(r.out, "list"));
+    CHECK(contains(r.out, "run"));
+  }
+}
+
+}  // TEST_SUITE

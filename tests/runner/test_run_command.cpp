@@ -1,0 +1,312 @@
+// End-to-end runs of `tsi run`: the files a good run writes, their content, aliases,
+// defaults, and the exit codes of completed and failed runs.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "run_command.hpp"
+
+namespace {
+
+using namespace tsi::test;
+
+/// Henon-Heiles energy H = I + H1 at u = (q1, q2, p1, p2), written out from SPEC.md sec. 4.
+double henon_heiles_energy(double q1, double q2, double p1, double p2, double eps) {
+  const double oscillatory = (q1 * q1 + p1 * p1) / (2.0 * eps);
+  const double h1 = q2 * q2 / 2.0 + p2 * p2 / 2.0 + q1 * q1 * q2 - q2 * q2 * q2 / 3.0;
+  return oscillatory + h1;
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST_SUITE("tsi_runner_tests") {
+
+TEST_CASE("run: the example config with --set time.h=0.25 writes a complete result.json") {
+  TempDir dir;
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", example_config(), "--out", out, "--set", "time.h=0.25"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  REQUIRE(fs::is_regular_file(fs::path(out) / "result.json"));
+  REQUIRE(fs::is_regular_file(fs::path(out) / "invariants.csv"));
+  CHECK(contains(r.out, "result.json"));
+  CHECK(contains(r.out, "invariants.csv"));
+
+  const Json result = read_json(fs::path(out) / "result.json");
+  INFO(result.dump(2));
+
+  SUBCASE("the config is fully resolved") {
+    const Json& c = result.at("config");
+    CHECK(c.at("model").at("name") == "henon-heiles");
+    CHECK(c.at("model").at("eps").get<double>() == doctest::Approx(0.01));
+    CHECK(c.at("reformulation").at("name") == "two-scale");
+    CHECK(c.at("reformulation").at("n_tau") == 64);
+    CHECK(c.at("reformulation").at("initial_data_order") == 2);
+    CHECK(c.at("scheme").at("name") == "se1");
+    CHECK(c.at("scheme").at("tol").get<double>() == doctest::Approx(1e-10));
+    CHECK(c.at("scheme").at("max_iter") == 200);
+    CHECK(c.at("time").at("h").get<double>() == 0.25);
+    CHECK(c.at("time").at("t_end").get<double>() == 1.0);
+    CHECK(c.at("reference").at("scheme") == "rk78");
+    CHECK(c.at("reference").at("reformulation") == "filtered");
+    CHECK(c.at("reference").at("tol").get<double>() == doctest::Approx(1e-13));
+    CHECK(c.at("output").at("every") == 1);
+  }
+
+  SUBCASE("steps, final time, final state and version") {
+    CHECK(result.at("status") == "completed");
+    CHECK(result.at("steps") == 4);
+    CHECK(result.at("t_end").get<double>() == 1.0);
+    const Json& u = result.at("u_final");
+    REQUIRE(u.is_array());
+    REQUIRE(u.size() == 4);
+    for (const auto& x : u) {
+      REQUIRE(x.is_number());
+      CHECK(std::isfinite(x.get<double>()));
+    }
+    REQUIRE(result.at("tsi_version").is_string());
+    CHECK_FALSE(result.at("tsi_version").get<std::string>().empty());
+    REQUIRE(result.at("wall_seconds").is_number());
+    CHECK(result.at("wall_seconds").get<double>() >= 0.0);
+  }
+
+  SUBCASE("the error against the reference is small and positive") {
+    REQUIRE(result.contains("error"));
+    const Json& relative = result.at("error").at("relative");
+    REQUIRE(relative.is_number());
+    const double e = relative.get<double>();
+    CHECK(std::isfinite(e));
+    CHECK(e > 0.0);
+    CHECK(e < 1e-2);
+  }
+
+  SUBCASE("invariants and solver statistics") {
+    for (const char* name : {"H", "I", "m"}) {
+      INFO("invariant " << name);
+      const Json& inv = result.at("invariants").at(name);
+      for (const char* key : {"initial", "final", "max_rel_error"}) {
+        INFO("key " << key);
+        REQUIRE(inv.at(key).is_number());
+        CHECK(std::isfinite(inv.at(key).get<double>()));
+      }
+      CHECK(inv.at("max_rel_error").get<double>() >= 0.0);
+    }
+    const Json& solver = result.at("solver");
+    REQUIRE(solver.at("iterations_mean").is_number());
+    REQUIRE(solver.at("iterations_max").is_number_integer());
+    REQUIRE(solver.at("not_converged").is_number_integer());
+    CHECK(solver.at("iterations_mean").get<double>() > 0.0);
+    CHECK(solver.at("iterations_max").get<long>() >= 1);
+    CHECK(solver.at("not_converged").get<long>() == 0);
+  }
+
+  SUBCASE("the initial energy is H(u0) = I + H1 computed by hand") {
+    const double eps = result.at("config").at("model").at("eps").get<double>();
+    const double expected = henon_heiles_energy(0.12, 0.12, 0.12, 0.12, eps);  // 1.455552 at eps = 0.01
+    CHECK(result.at("invariants").at("H").at("initial").get<double>() == doctest::Approx(expected).epsilon(1e-13));
+    CHECK(result.at("invariants").at("I").at("initial").get<double>() ==
+          doctest::Approx((0.12 * 0.12 + 0.12 * 0.12) / (2.0 * eps)).epsilon(1e-13));
+    CHECK(result.at("invariants").at("m").at("initial").get<double>() ==
+          doctest::Approx(4.0 * 0.12 * 0.12).epsilon(1e-13));
+  }
+
+  SUBCASE("invariants.csv: header, one row per step, zero errors at t = 0") {
+    const std::vector<std::string> lines = lines_of(read_text(fs::path(out) / "invariants.csv"));
+    REQUIRE(lines.size() == 1 + 4 + 1);
+    CHECK(lines[0] == "t,H,I,m,err_H,err_I,err_m,tau_roughness");
+    for (std::size_t i = 1; i < lines.size(); ++i) {
+      INFO("row " << i << ": " << lines[i]);
+      const auto fields = csv_fields(lines[i]);
+      REQUIRE(fields.size() == 8);
+      CHECK(std::stod(fields[0]) == doctest::Approx(0.25 * static_cast<double>(i - 1)));
+      for (const auto& f : fields) CHECK(std::isfinite(std::stod(f)));
+    }
+    const auto first = csv_fields(lines[1]);
+    CHECK(std::stod(first[0]) == 0.0);
+    CHECK(std::stod(first[1]) == doctest::Approx(result.at("invariants").at("H").at("initial").get<double>()));
+    CHECK(std::stod(first[4]) == 0.0);
+    CHECK(std::stod(first[5]) == 0.0);
+    CHECK(std::stod(first[6]) == 0.0);
+    const auto last = csv_fields(lines.back());
+    CHECK(std::stod(last[0]) == doctest::Approx(1.0));
+    CHECK(std::stod(last[1]) == doctest::Approx(result.at("invariants").at("H").at("final").get<double>()));
+  }
+}
+
+TEST_CASE("run: output.every thins the rows of invariants.csv but keeps the last step") {
+  TempDir dir;
+  Json config = small_config();
+  config["time"] = {{"h", 0.125}, {"t_end", 1.0}};
+  config["output"] = {{"every", 3}};
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", write_config(dir, config), "--out", out});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  const auto lines = lines_of(read_text(fs::path(out) / "invariants.csv"));
+  // steps 0, 3, 6 and the last step 8
+  REQUIRE(lines.size() == 1 + 4);
+  CHECK(std::stod(csv_fields(lines[1])[0]) == 0.0);
+  CHECK(std::stod(csv_fields(lines[2])[0]) == doctest::Approx(0.375));
+  CHECK(std::stod(csv_fields(lines[3])[0]) == doctest::Approx(0.75));
+  CHECK(std::stod(csv_fields(lines[4])[0]) == doctest::Approx(1.0));
+}
+
+TEST_CASE("run: aliases hh and se1-tsi are accepted and resolved to the canonical names") {
+  TempDir dir;
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", write_config(dir, small_config()), "--out", out, "--set",
+                                   "model.name=hh", "--set", "scheme.name=se1-tsi"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  const Json result = read_json(fs::path(out) / "result.json");
+  CHECK(result.at("config").at("model").at("name") == "henon-heiles");
+  CHECK(result.at("config").at("scheme").at("name") == "se1");
+  CHECK(result.at("steps") == 4);
+}
+
+TEST_CASE("run: the alias se1-tsi works in a config file too") {
+  TempDir dir;
+  Json config = small_config();
+  config["model"]["name"] = "hh";
+  config["scheme"]["name"] = "se1-tsi";
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", write_config(dir, config), "--out", out});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  const Json result = read_json(fs::path(out) / "result.json");
+  CHECK(result.at("config").at("model").at("name") == "henon-heiles");
+  CHECK(result.at("config").at("scheme").at("name") == "se1");
+}
+
+TEST_CASE("run: without a reference key there is no error in result.json") {
+  TempDir dir;
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", write_config(dir, small_config()), "--out", out});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  const Json result = read_json(fs::path(out) / "result.json");
+  CHECK_FALSE(result.contains("error"));
+  CHECK_FALSE(result.at("config").contains("reference"));
+  CHECK(result.at("status") == "completed");
+  CHECK(result.contains("invariants"));
+}
+
+TEST_CASE("run: an empty reference section gets its defaults (rk78 on filtered with tol 1e-13)") {
+  TempDir dir;
+  Json config = small_config();
+  config["reference"] = Json::object();
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", write_config(dir, config), "--out", out});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  const Json result = read_json(fs::path(out) / "result.json");
+  const Json& ref = result.at("config").at("reference");
+  CHECK(ref.at("scheme") == "rk78");
+  CHECK(ref.at("reformulation") == "filtered");
+  CHECK(ref.at("tol").get<double>() == doctest::Approx(1e-13));
+  REQUIRE(result.contains("error"));
+  const double e = result.at("error").at("relative").get<double>();
+  CHECK(std::isfinite(e));
+  CHECK(e > 0.0);
+  CHECK(e < 1e-2);
+}
+
+TEST_CASE("run: defaults fill a config that names only the model") {
+  TempDir dir;
+  const Json config = Json::parse(R"({"model": {"name": "henon-heiles", "eps": 0.1}, "time": {"h": 0.5}})");
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", write_config(dir, config), "--out", out});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  const Json c = read_json(fs::path(out) / "result.json").at("config");
+  CHECK(c.at("scheme").at("name") == "se1");
+  CHECK(c.at("reformulation").at("name") == "two-scale");
+  CHECK(c.at("reformulation").at("n_tau") == 64);            // the model's own
+  CHECK(c.at("reformulation").at("initial_data_order") == 2);  // what se1 needs
+  CHECK(c.at("time").at("t_end").get<double>() == 1.0);
+  CHECK(c.at("output").at("every") == 1);
+  CHECK(c.at("plugins") == Json::array());
+}
+
+TEST_CASE("run: --set overrides a value of the config file") {
+  TempDir dir;
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", write_config(dir, small_config()), "--out", out, "--set",
+                                   "model.eps=0.5", "--set", "time.t_end=0.5"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  const Json result = read_json(fs::path(out) / "result.json");
+  CHECK(result.at("config").at("model").at("eps").get<double>() == 0.5);
+  CHECK(result.at("steps") == 2);
+  CHECK(result.at("t_end").get<double>() == 0.5);
+  // the initial oscillatory energy scales with 1/eps
+  CHECK(result.at("invariants").at("I").at("initial").get<double>() == doctest::Approx((0.12 * 0.12 + 0.12 * 0.12) / (2.0 * 0.5)));
+}
+
+TEST_CASE("run: model.u0 replaces the model's initial value") {
+  TempDir dir;
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi(
+      {"run", write_config(dir, small_config()), "--out", out, "--set", "model.u0=[0.1, 0.2, 0.0, 0.0]"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  const Json result = read_json(fs::path(out) / "result.json");
+  CHECK(result.at("invariants").at("H").at("initial").get<double>() ==
+        doctest::Approx(henon_heiles_energy(0.1, 0.2, 0.0, 0.0, 0.1)).epsilon(1e-13));
+}
+
+TEST_CASE("run: without --out the files go to out/<config name> under the working directory") {
+  TempDir dir;
+  const std::string config = write_config(dir, small_config(), "my-run.json");
+  const CommandResult r = run_tsi({"run", config}, {}, dir.path().string());
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  CHECK(fs::is_regular_file(dir.path() / "out" / "my-run" / "result.json"));
+  CHECK(fs::is_regular_file(dir.path() / "out" / "my-run" / "invariants.csv"));
+}
+
+TEST_CASE("run: t_end = 0 is zero steps and one row at t = 0") {
+  TempDir dir;
+  const std::string out = dir / "out";
+  const CommandResult r =
+      run_tsi({"run", write_config(dir, small_config()), "--out", out, "--set", "time.t_end=0"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  const Json result = read_json(fs::path(out) / "result.json");
+  CHECK(result.at("steps") == 0);
+  const auto lines = lines_of(read_text(fs::path(out) / "invariants.csv"));
+  CHECK(lines.size() == 2);
+}
+
+TEST_CASE("run: a run that fails part-way exits 1 and still writes its files") {
+  // Explicit Euler (the fixture scheme) on the stiff direct problem with h / eps = 100:
+  // the solution grows by about 100 per step and overflows within 200 steps.
+  TempDir dir;
+  const Json config = {{"plugins", {fixture_plugin("good")}},
+                       {"model", {{"name", "fixture-model"}, {"eps", 0.01}}},
+                       {"scheme", {{"name", "fixture-scheme"}}},
+                       {"reformulation", {{"name", "direct"}}},
+                       {"time", {{"h", 1.0}, {"t_end", 400.0}}}};
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", write_config(dir, config), "--out", out});
+  INFO(r.describe());
+  CHECK(r.exit_code == 1);
+  CHECK(r.signal == 0);
+  CHECK(contains(r.err, "non-finite"));
+  REQUIRE(fs::is_regular_file(fs::path(out) / "result.json"));
+  REQUIRE(fs::is_regular_file(fs::path(out) / "invariants.csv"));
+  const Json result = read_json(fs::path(out) / "result.json");
+  CHECK(result.at("status") == "failed");
+  CHECK(contains(result.at("message").get<std::string>(), "non-finite"));
+  CHECK(result.at("steps").get<long>() > 0);
+  CHECK(result.at("steps").get<long>() < 400);
+  const auto lines = lines_of(read_text(fs::path(out) / "invariants.csv"));
+  CHECK(lines.at(0) == "t,H,I,m,err_H,err_I,err_m,tau_roughness");
+  CHECK(lines.size() > 2);
+}
+
+}  // TEST_SUITE

@@ -1,0 +1,309 @@
+// Bad input to `tsi run`: exit code 2, no signal, no files written, and a message on stderr
+// "tsi: error: FIELD: ..." that names the field, the offending value and what was expected.
+#include <doctest/doctest.h>
+
+#include <string>
+#include <vector>
+
+#include "run_command.hpp"
+
+namespace {
+
+using namespace tsi::test;
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+/// Checks a bad-input outcome: exit code 2, the "tsi: error: FIELD:" prefix, every fragment.
+void check_bad_input(const CommandResult& r, const std::string& field, const std::vector<std::string>& fragments) {
+  INFO(r.describe());
+  CHECK(r.signal == 0);
+  CHECK(r.exit_code == 2);
+  CHECK(contains(r.err, "tsi: error: " + field + ":"));
+  for (const auto& f : fragments) {
+    INFO("expected on stderr: " << f);
+    CHECK(contains(r.err, f));
+  }
+}
+
+/// Runs the example config with `--set` overrides into a fresh directory; checks that bad
+/// input writes nothing and returns the outcome.
+CommandResult run_example_with(const std::vector<std::string>& assignments) {
+  TempDir dir;
+  const std::string out = dir / "out";
+  std::vector<std::string> args = {"run", example_config(), "--out", out};
+  for (const auto& a : assignments) {
+    args.push_back("--set");
+    args.push_back(a);
+  }
+  CommandResult r = run_tsi(args);
+  if (r.exit_code == 2) {
+    INFO(r.describe());
+    CHECK_FALSE(fs::exists(fs::path(out) / "result.json"));
+  }
+  return r;
+}
+
+/// Runs a config given as JSON text into a fresh directory.
+CommandResult run_config_text(const std::string& text, const std::vector<std::string>& extra = {}) {
+  TempDir dir;
+  const std::string config = dir / "config.json";
+  write_text(config, text);
+  const std::string out = dir / "out";
+  std::vector<std::string> args = {"run", config, "--out", out};
+  args.insert(args.end(), extra.begin(), extra.end());
+  CommandResult r = run_tsi(args);
+  if (r.exit_code == 2) {
+    INFO(r.describe());
+    CHECK_FALSE(fs::exists(fs::path(out) / "result.json"));
+  }
+  return r;
+}
+
+CommandResult run_config(const Json& config, const std::vector<std::string>& extra = {}) {
+  return run_config_text(config.dump(2), extra);
+}
+
+}  // namespace
+
+TEST_SUITE("tsi_runner_tests") {
+
+TEST_CASE("run errors: an unknown model lists the valid models") {
+  check_bad_input(run_example_with({"model.name=no-such-model"}), "model.name",
+                  {"unknown model", "\"no-such-model\"", "henon-heiles", "hh"});
+}
+
+TEST_CASE("run errors: an unknown scheme lists the valid schemes") {
+  check_bad_input(run_example_with({"scheme.name=no-such-scheme"}), "scheme.name",
+                  {"unknown scheme", "\"no-such-scheme\"", "se1", "rk78"});
+}
+
+TEST_CASE("run errors: an unknown reformulation lists the valid reformulations") {
+  check_bad_input(run_example_with({"reformulation.name=no-such-reformulation"}), "reformulation.name",
+                  {"unknown reformulation", "\"no-such-reformulation\"", "two-scale", "filtered", "direct"});
+}
+
+TEST_CASE("run errors: eps outside 0 to 1") {
+  SUBCASE("eps = 2") {
+    check_bad_input(run_example_with({"model.eps=2"}), "model.eps", {"got 2", "expected", "(0, 1]"});
+  }
+  SUBCASE("eps = 0") {
+    check_bad_input(run_example_with({"model.eps=0"}), "model.eps", {"got 0", "expected", "(0, 1]"});
+  }
+  SUBCASE("eps = -1") {
+    check_bad_input(run_example_with({"model.eps=-1"}), "model.eps", {"got -1", "expected", "(0, 1]"});
+  }
+}
+
+TEST_CASE("run errors: eps of the wrong type") {
+  check_bad_input(run_example_with({"model.eps=\"abc\""}), "model.eps", {"got \"abc\"", "expected a number"});
+}
+
+TEST_CASE("run errors: a bare word where a number is expected") {
+  check_bad_input(run_example_with({"time.h=fast"}), "time.h", {"got \"fast\"", "expected a number"});
+}
+
+TEST_CASE("run errors: a non-positive time step") {
+  SUBCASE("h = 0") {
+    check_bad_input(run_example_with({"time.h=0"}), "time.h", {"got 0", "expected", "(0, inf)"});
+  }
+  SUBCASE("h = -0.1") {
+    check_bad_input(run_example_with({"time.h=-0.1"}), "time.h", {"got -0.1", "expected", "(0, inf)"});
+  }
+}
+
+TEST_CASE("run errors: a negative final time") {
+  check_bad_input(run_example_with({"time.t_end=-1"}), "time.t_end", {"got -1", "expected", "[0, inf)"});
+}
+
+TEST_CASE("run errors: t_end that is not a whole number of steps") {
+  check_bad_input(run_example_with({"time.h=0.3"}), "time.h", {"t_end = 1", "h = 0.3", "whole number of steps"});
+}
+
+TEST_CASE("run errors: n_tau must be a positive even integer") {
+  SUBCASE("odd") {
+    check_bad_input(run_example_with({"reformulation.n_tau=63"}), "reformulation.n_tau",
+                    {"got 63", "positive even integer"});
+  }
+  SUBCASE("zero") {
+    check_bad_input(run_example_with({"reformulation.n_tau=0"}), "reformulation.n_tau",
+                    {"got 0", "positive even integer"});
+  }
+  SUBCASE("not an integer") {
+    check_bad_input(run_example_with({"reformulation.n_tau=2.5"}), "reformulation.n_tau",
+                    {"got 2.5", "integer"});
+  }
+  SUBCASE("negative") {
+    check_bad_input(run_example_with({"reformulation.n_tau=-4"}), "reformulation.n_tau",
+                    {"got -4", "positive even integer"});
+  }
+}
+
+TEST_CASE("run errors: initial_data_order must be 1 2 or 3") {
+  check_bad_input(run_example_with({"reformulation.initial_data_order=4"}), "reformulation.initial_data_order",
+                  {"got 4", "1, 2 or 3"});
+}
+
+TEST_CASE("run errors: scheme parameters are checked") {
+  SUBCASE("se1 tol = 0") {
+    check_bad_input(run_example_with({"scheme.tol=0"}), "scheme.tol", {"got 0", "expected", "(0, 1)"});
+  }
+  SUBCASE("se1 max_iter = 0") {
+    check_bad_input(run_example_with({"scheme.max_iter=0"}), "scheme.max_iter",
+                    {"got 0", "positive integer"});
+  }
+}
+
+TEST_CASE("run errors: output.every must be a positive integer") {
+  check_bad_input(run_example_with({"output.every=0"}), "output.every", {"got 0", "positive integer"});
+}
+
+TEST_CASE("run errors: a scheme that cannot integrate the reformulation names the compatible ones") {
+  const Json config = Json::parse(R"({
+    "model": {"name": "henon-heiles", "eps": 0.1},
+    "reformulation": {"name": "two-scale"},
+    "scheme": {"name": "rk78"},
+    "time": {"h": 0.25, "t_end": 1.0}
+  })");
+  check_bad_input(run_config(config), "reformulation.name",
+                  {"\"rk78\"", "\"two-scale\"", "compatible reformulations: direct, filtered"});
+}
+
+TEST_CASE("run errors: the reference pair is checked for compatibility too") {
+  const Json config = Json::parse(R"({
+    "model": {"name": "henon-heiles", "eps": 0.1},
+    "scheme": {"name": "se1"},
+    "time": {"h": 0.25, "t_end": 1.0},
+    "reference": {"scheme": "se1", "reformulation": "direct", "h": 0.25}
+  })");
+  check_bad_input(run_config(config), "reference.reformulation",
+                  {"\"se1\"", "\"direct\"", "filtered, two-scale"});
+}
+
+TEST_CASE("run errors: an unknown reference scheme names reference.scheme") {
+  const Json config = Json::parse(R"({
+    "model": {"name": "henon-heiles", "eps": 0.1},
+    "time": {"h": 0.25, "t_end": 1.0},
+    "reference": {"scheme": "no-such-scheme"}
+  })");
+  check_bad_input(run_config(config), "reference.scheme", {"unknown scheme", "\"no-such-scheme\"", "rk78"});
+}
+
+TEST_CASE("run errors: a non-adaptive reference scheme needs a step") {
+  const Json config = Json::parse(R"({
+    "model": {"name": "henon-heiles", "eps": 0.1},
+    "time": {"h": 0.25, "t_end": 1.0},
+    "reference": {"scheme": "se1", "reformulation": "two-scale"}
+  })");
+  check_bad_input(run_config(config), "reference.h", {"\"se1\"", "not adaptive"});
+}
+
+TEST_CASE("run errors: a missing config file") {
+  TempDir dir;
+  const std::string missing = dir / "no-such-config.json";
+  const CommandResult r = run_tsi({"run", missing, "--out", dir / "out"});
+  check_bad_input(r, missing, {"cannot open"});
+  CHECK_FALSE(fs::exists(dir.path() / "out"));
+}
+
+TEST_CASE("run errors: a malformed JSON file") {
+  TempDir dir;
+  const std::string config = dir / "broken.json";
+  write_text(config, "{\"model\": {\"name\": \"henon-heiles\",\n");
+  const CommandResult r = run_tsi({"run", config, "--out", dir / "out"});
+  check_bad_input(r, config, {"malformed JSON", "line"});
+  CHECK_FALSE(fs::exists(dir.path() / "out"));
+}
+
+TEST_CASE("run errors: a config that is not a JSON object") {
+  check_bad_input(run_config_text("[1, 2, 3]"), "config", {"got [1,2,3]", "expected a JSON object"});
+}
+
+TEST_CASE("run errors: an unknown top-level section in a config file") {
+  Json config = small_config();
+  config["bogus_section"] = {{"x", 1}};
+  check_bad_input(run_config(config), "bogus_section",
+                  {"unknown section", "valid sections are", "model", "reformulation", "scheme", "time", "reference"});
+}
+
+TEST_CASE("run errors: a section that is not an object") {
+  Json config = small_config();
+  config["time"] = 5;
+  check_bad_input(run_config(config), "time", {"got 5", "expected an object"});
+}
+
+TEST_CASE("run errors: a config without a model name") {
+  const Json config = Json::parse(R"({"model": {"eps": 0.1}, "time": {"h": 0.25}})");
+  check_bad_input(run_config(config), "model.name", {"missing"});
+}
+
+TEST_CASE("run errors: an unknown parameter in a config file lists the valid ones") {
+  Json config = small_config();
+  config["scheme"]["tolerance"] = 1e-8;
+  check_bad_input(run_config(config), "scheme.tolerance",
+                  {"unknown parameter", "valid parameters are", "max_iter", "tol"});
+}
+
+TEST_CASE("run errors: --set of a parameter that does not exist") {
+  check_bad_input(run_example_with({"model.foo=1"}), "model.foo",
+                  {"unknown parameter", "valid parameters are", "eps", "u0"});
+}
+
+TEST_CASE("run errors: --set in a section that does not exist") {
+  const CommandResult r = run_example_with({"nosuch.x=1"});
+  check_bad_input(r, "--set nosuch.x", {"unknown section", "\"nosuch\"", "valid sections are", "model", "time"});
+}
+
+TEST_CASE("run errors: --set without a value") {
+  check_bad_input(run_example_with({"model.eps"}), "--set", {"\"model.eps\"", "expected key.path=value"});
+}
+
+TEST_CASE("run errors: --set with an empty key component") {
+  check_bad_input(run_example_with({"model..eps=0.1"}), "--set model..eps", {"empty component"});
+}
+
+TEST_CASE("run errors: --set through a value that is not an object") {
+  check_bad_input(run_example_with({"model.eps.x=1"}), "--set model.eps.x", {"not an object"});
+}
+
+TEST_CASE("run errors: model.u0 of the wrong length is bad input") {
+  // Validated when the run starts; bad input all the same: exit code 2.
+  check_bad_input(run_example_with({"model.u0=[0.1, 0.2, 0.3]"}), "model.u0", {"got 3 entries", "expected 4"});
+}
+
+TEST_CASE("run errors: a model.u0 entry that is not a number is bad input") {
+  check_bad_input(run_example_with({"model.u0=[0.1, 0.2, 0.3, \"x\"]"}), "model.u0[3]",
+                  {"got \"x\"", "expected a number"});
+}
+
+TEST_CASE("run errors: a missing plugin in the config names the plugins field and the file") {
+  TempDir dir;
+  Json config = small_config();
+  config["plugins"] = {"no-such-plugin.so"};
+  const std::string file = write_config(dir, config);
+  const CommandResult r = run_tsi({"run", file, "--out", dir / "out"});
+  check_bad_input(r, "plugins", {"no-such-plugin.so", "no such file"});
+}
+
+TEST_CASE("run errors: plugins that is not a list") {
+  Json config = small_config();
+  config["plugins"] = "tsi_fixture_good.so";
+  check_bad_input(run_config(config), "plugins", {"got \"tsi_fixture_good.so\"", "expected a list"});
+}
+
+TEST_CASE("run errors: a missing CONFIG argument is a usage error") {
+  const CommandResult r = run_tsi({"run"});
+  INFO(r.describe());
+  CHECK(r.signal == 0);
+  CHECK(r.exit_code == 2);
+  CHECK(contains(r.err, "config"));
+}
+
+TEST_CASE("run errors: an unknown command-line option is a usage error") {
+  const CommandResult r = run_tsi({"run", example_config(), "--no-such-option"});
+  INFO(r.describe());
+  CHECK(r.signal == 0);
+  CHECK(r.exit_code == 2);
+  CHECK(contains(r.err, "--no-such-option"));
+}
+
+}  // TEST_SUITE
