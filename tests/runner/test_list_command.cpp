@@ -43,7 +43,7 @@ Json list_json(const std::vector<std::string>& extra = {}) {
 
 TEST_SUITE("tsi_runner_tests") {
 
-TEST_CASE("list --json: models, reformulations and schemes") {
+TEST_CASE("list --json: models and reformulations and schemes") {
   const Json all = list_json();
   INFO(all.dump(2));
   REQUIRE(all.at("models").is_array());
