@@ -1,8 +1,10 @@
 #pragma once
 // Builds models, reformulations and schemes from the shipped plugins, as the runner does,
 // for tests that drive the numerics directly.
+#include <map>
 #include <memory>
 #include <string>
+#include <tuple>
 
 #include "tsi/driver.hpp"
 #include "tsi/phase.hpp"
@@ -51,6 +53,19 @@ inline Vector solve(const Model& model, Reformulation& reformulation, Stepper& s
   const double h = t_end / static_cast<double>(n);
   integrate(reformulation, stepper, y, h, n, {});
   return model.to_physical(reformulation.read_back(y, step_time(n, h)));
+}
+
+/// The reference u(t_end) for the model's u0: rk78 (tol 1e-13) on the filtered problem,
+/// another reformulation and another scheme than the two-scale ones under test. Cached.
+inline const Vector& reference_solution(const std::string& model_name, double eps, double t_end) {
+  static std::map<std::tuple<std::string, double, double>, Vector> cache;
+  const auto key = std::make_tuple(model_name, eps, t_end);
+  if (auto it = cache.find(key); it != cache.end()) return it->second;
+  auto& h = Harness::instance();
+  auto model = h.model(model_name, eps);
+  auto filtered = h.reformulation("filtered", model);
+  auto rk78 = h.scheme("rk78", {{"tol", 1e-13}});
+  return cache[key] = solve(*model, *filtered, *rk78, t_end, 1);
 }
 
 }  // namespace tsi::test

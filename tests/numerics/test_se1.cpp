@@ -12,15 +12,6 @@ namespace {
 using tsi::Vector;
 using tsi::test::Harness;
 
-// The reference: rk78 on the filtered problem (another reformulation, another scheme).
-Vector reference(double eps, double t_end) {
-  auto& h = Harness::instance();
-  auto model = h.model("henon-heiles", eps);
-  auto filtered = h.reformulation("filtered", model);
-  auto rk78 = h.scheme("rk78", {{"tol", 1e-13}});
-  return tsi::test::solve(*model, *filtered, *rk78, t_end, 1);
-}
-
 double se1_error(double eps, long steps, const Vector& ref) {
   auto& h = Harness::instance();
   auto model = h.model("henon-heiles", eps);
@@ -39,7 +30,7 @@ TEST_CASE("SE1 two-scale is uniformly second order on Henon-Heiles at T = 1") {
   for (long n : steps) hs.push_back(1.0 / static_cast<double>(n));
   std::map<double, std::vector<double>> errors;
   for (double eps : epsilons) {
-    const Vector ref = reference(eps, 1.0);
+    const Vector& ref = tsi::test::reference_solution("henon-heiles", eps, 1.0);
     for (long n : steps) errors[eps].push_back(se1_error(eps, n, ref));
   }
   for (double eps : epsilons) {

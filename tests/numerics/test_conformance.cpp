@@ -1,0 +1,102 @@
+// One suite across every registered scheme that integrates the two-scale problem (no list
+// written by hand: a new scheme plugin joins it by registering). On Henon-Heiles:
+// uniform second order at T = 1, and time symmetry exactly where the scheme declares it.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+
+#include "harness.hpp"
+#include "tsi/convergence.hpp"
+
+namespace {
+
+using tsi::Vector;
+using tsi::test::Harness;
+
+std::vector<const tsi::SchemeEntry*> two_scale_schemes() {
+  std::vector<const tsi::SchemeEntry*> out;
+  for (const auto* e : Harness::instance().registry().schemes()) {
+    const auto& r = e->traits.reformulations;
+    if (std::find(r.begin(), r.end(), "two-scale") != r.end()) out.push_back(e);
+  }
+  return out;
+}
+
+// Relative error at T = 1 with the prepared data the scheme declares it needs.
+double error_at_one(const tsi::SchemeEntry& scheme, double eps, long steps) {
+  auto& h = Harness::instance();
+  auto model = h.model("henon-heiles", eps);
+  auto two_scale = h.reformulation("two-scale", model,
+                                   {{"n_tau", 64}, {"initial_data_order", std::max(1, scheme.traits.initial_data_order)}});
+  tsi::Json params = tsi::Json::object();
+  for (const auto& p : scheme.info.params)
+    if (p.name == "tol") params["tol"] = 1e-12;
+  auto stepper = h.scheme(scheme.info.name, params);
+  const Vector& ref = tsi::test::reference_solution("henon-heiles", eps, 1.0);
+  return (tsi::test::solve(*model, *two_scale, *stepper, 1.0, steps) - ref).norm() / ref.norm();
+}
+
+}  // namespace
+
+TEST_CASE("conformance: the two-scale schemes include the paper's four") {
+  std::vector<std::string> names;
+  for (const auto* e : two_scale_schemes()) names.push_back(e->info.name);
+  for (const char* expected : {"fd", "me", "se1", "se2"})
+    CHECK(std::find(names.begin(), names.end(), expected) != names.end());
+}
+
+TEST_CASE("conformance: every two-scale scheme is uniformly second order on Henon-Heiles") {
+  const std::vector<double> epsilons = {1.0, 1.0 / 16, 1.0 / 256, 1.0 / 4096, 1e-6};
+  const std::vector<long> steps = {4, 8, 16, 32, 64};  // h = 1/4 .. 1/64
+  std::vector<double> hs;
+  for (long n : steps) hs.push_back(1.0 / static_cast<double>(n));
+  for (const auto* scheme : two_scale_schemes()) {
+    std::vector<std::vector<double>> errors;
+    for (double eps : epsilons) {
+      errors.emplace_back();
+      for (long n : steps) errors.back().push_back(error_at_one(*scheme, eps, n));
+    }
+    CAPTURE(scheme->info.name);
+    for (size_t k = 0; k < epsilons.size(); ++k) {
+      const double order = tsi::least_squares_order(hs, errors[k]);
+      CAPTURE(epsilons[k]);
+      CAPTURE(order);
+      CHECK(order == doctest::Approx(2.0).epsilon(0.075));  // 2 +- 0.15
+    }
+    for (size_t i = 0; i < hs.size(); ++i) {
+      double largest = 0.0;
+      for (const auto& e : errors) largest = std::max(largest, e[i]);
+      CAPTURE(hs[i]);
+      CHECK(largest <= 1.5 * errors[0][i]);  // max over eps within 1.5x of eps = 1
+    }
+  }
+}
+
+TEST_CASE("conformance: a step h then -h returns the state exactly when the scheme is symmetric") {
+  auto& h = Harness::instance();
+  for (const auto* scheme : two_scale_schemes()) {
+    for (double eps : {1.0, 1e-2, 1e-6}) {
+      auto model = h.model("henon-heiles", eps);
+      auto two_scale = h.reformulation("two-scale", model);
+      tsi::Json params = tsi::Json::object();
+      for (const auto& p : scheme->info.params) {
+        if (p.name == "tol") params["tol"] = 1e-15;
+        if (p.name == "max_iter") params["max_iter"] = 1000;
+      }
+      auto stepper = h.scheme(scheme->info.name, params);
+      const Vector start = two_scale->prepare(model->initial_value());
+      Vector y = start;
+      stepper->reset();
+      stepper->step(*two_scale, 0.0, 0.5, y);
+      stepper->step(*two_scale, 0.5, -0.5, y);
+      const double back = tsi::max_norm(y - start) / tsi::max_norm(start);
+      CAPTURE(scheme->info.name);
+      CAPTURE(eps);
+      CAPTURE(back);
+      if (scheme->traits.symmetric)
+        CHECK(back <= 1e-12);
+      else
+        CHECK(back > 1e-8);  // would fail if the scheme became symmetric
+    }
+  }
+}
