@@ -137,8 +137,12 @@ def plot(study, rows, out):
         return
     ok = [r for r in rows if r["status"] == "completed" and r["error"]]
     conv_groups = [g for g in study["groups"] if "time.h" in g.get("vary", {})]
-    fig, axes = plt.subplots(1, len(conv_groups), figsize=(6.4 * len(conv_groups), 4.8), squeeze=False)
-    for ax, g in zip(axes[0], conv_groups):
+    ncols = min(2, len(conv_groups))
+    nrows = (len(conv_groups) + ncols - 1) // ncols
+    fig, axes = plt.subplots(nrows, ncols, figsize=(6.4 * ncols, 4.8 * nrows), squeeze=False)
+    for ax in axes.flat[len(conv_groups):]:
+        ax.set_visible(False)
+    for ax, g in zip(axes.flat, conv_groups):
         g_rows = [r for r in ok if r["group"] == g["label"]]
         for e in sorted({r["eps"] for r in g_rows}, reverse=True):
             pts = sorted((r["h"], r["error"]) for r in g_rows if r["eps"] == e)
@@ -154,8 +158,8 @@ def plot(study, rows, out):
     fig.tight_layout()
     fig.savefig(os.path.join(out, "convergence.png"), dpi=120)
 
-    fig, ax = plt.subplots(figsize=(7.2, 5.2))
-    styles = itertools.cycle(["o-", "s--", "^:", "vD-."])
+    fig, ax = plt.subplots(figsize=(11.5, 5.6))
+    styles = itertools.cycle(["o-", "s--", "^:", "v-.", "D-"])
     all_eps = sorted({r["eps"] for r in ok}, reverse=True)
     colors = {e: f"C{i}" for i, e in enumerate(all_eps)}
     for g in study["groups"]:
@@ -168,7 +172,7 @@ def plot(study, rows, out):
     ax.set_ylabel("relative error at t_end")
     ax.set_title("Work against precision")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
+    ax.legend(fontsize=7, ncol=1, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
     fig.savefig(os.path.join(out, "work_precision.png"), dpi=120)
     print(f"\n  plots: {out}/convergence.png, {out}/work_precision.png")
