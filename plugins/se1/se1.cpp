@@ -60,11 +60,7 @@ void register_se1(tsi::Registry& registry) {
   entry.info.name = "se1";
   entry.info.aliases = {"se1-tsi"};
   entry.info.summary = "SE1-TSI: symmetric exponential, implicit midpoint stage (eq. S1)";
-  entry.info.params = {
-      tsi::number_param("tol", 1e-10, "fixed-point tolerance on the relative max-norm increment")
-          .range(0.0, 1.0, true, true),
-      tsi::integer_param("max_iter", 200, "most fixed-point sweeps per stage")
-          .check([](const tsi::Json& v) { return v.get<long>() >= 1; }, "a positive integer")};
+  entry.info.params = tsi::fixed_point_params();
   entry.traits.order = 2;
   entry.traits.symmetric = true;
   entry.traits.implicit = true;
@@ -72,7 +68,7 @@ void register_se1(tsi::Registry& registry) {
   entry.traits.initial_data_order = 2;
   entry.traits.reformulations = {"filtered", "two-scale"};
   entry.create = [](const tsi::Params& p) {
-    return std::make_unique<Se1>(tsi::FixedPointOptions{p.number("tol"), static_cast<int>(p.integer("max_iter"))});
+    return std::make_unique<Se1>(tsi::fixed_point_options(p));
   };
   registry.add_scheme(std::move(entry));
 }

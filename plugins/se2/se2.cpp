@@ -55,15 +55,12 @@ void register_se2(tsi::Registry& registry) {
   entry.info.name = "se2";
   entry.info.aliases = {"se2-tsi"};
   entry.info.summary = "SE2-TSI: symmetric exponential average-vector-field scheme (eq. S2)";
-  entry.info.params = {
-      tsi::number_param("tol", 1e-10, "fixed-point tolerance on the relative max-norm increment")
-          .range(0.0, 1.0, true, true),
-      tsi::integer_param("max_iter", 200, "most fixed-point sweeps per step")
-          .check([](const tsi::Json& v) { return v.get<long>() >= 1; }, "a positive integer"),
+  entry.info.params = tsi::fixed_point_params();
+  entry.info.params.push_back(
       tsi::integer_param("quadrature_nodes", 2,
                          "Gauss-Legendre nodes for the rho-integral (2: exact for cubic N)")
           .check([](const tsi::Json& v) { return v.get<long>() >= 1 && v.get<long>() <= 64; },
-                 "an integer from 1 to 64")};
+                 "an integer from 1 to 64"));
   entry.traits.order = 2;
   entry.traits.symmetric = true;
   entry.traits.implicit = true;
@@ -71,9 +68,7 @@ void register_se2(tsi::Registry& registry) {
   entry.traits.initial_data_order = 2;
   entry.traits.reformulations = {"filtered", "two-scale"};
   entry.create = [](const tsi::Params& p) {
-    return std::make_unique<Se2>(
-        tsi::FixedPointOptions{p.number("tol"), static_cast<int>(p.integer("max_iter"))},
-        static_cast<int>(p.integer("quadrature_nodes")));
+    return std::make_unique<Se2>(tsi::fixed_point_options(p), static_cast<int>(p.integer("quadrature_nodes")));
   };
   registry.add_scheme(std::move(entry));
 }

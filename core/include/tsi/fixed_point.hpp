@@ -1,5 +1,6 @@
 #pragma once
 #include "tsi/export.hpp"
+#include "tsi/params.hpp"
 #include "tsi/stepper.hpp"
 #include "tsi/types.hpp"
 
@@ -10,6 +11,11 @@ struct TSI_API FixedPointOptions {
   double tol = 1e-10;  ///< stop when max|x_{k+1} - x_k| <= tol * max|x_{k+1}|
   int max_iter = 200;  ///< give up (and count a failure) after this many sweeps
 };
+
+/// The parameters every implicit scheme takes for its fixed-point iteration: tol, max_iter.
+TSI_API ParamSchema fixed_point_params();
+/// FixedPointOptions from resolved parameters that include fixed_point_params().
+TSI_API FixedPointOptions fixed_point_options(const Params& params);
 
 /// Solves x = G(x) by Picard iteration and keeps the statistics a run reports.
 class TSI_API FixedPointSolver {
