@@ -16,6 +16,11 @@ class Direct final : public Reformulation {
   void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
   void rhs(double t, const Vector& y, Vector& out) override;
 
+  /// Exact flows when the model has an exact nonlinear flow: e^{hL} = e^{JM h/eps}.
+  bool has_exact_flows() const override { return model_->has_exact_nonlinear_flow(); }
+  void linear_flow(double h, Vector& y) override { y = model_->linear_flow(h / model_->eps(), y); }
+  void nonlinear_flow(double /*t*/, double h, Vector& y) override { model_->nonlinear_flow(h, y); }
+
   Vector prepare(const Vector& u0) override { return u0; }
   Vector read_back(const Vector& y, double /*t*/) override { return y; }
 

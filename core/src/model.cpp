@@ -35,6 +35,10 @@ void Model::nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef dir
   }
 }
 
+void Model::nonlinear_flow(double /*t*/, Vector& /*u*/) const {
+  throw Error("this model has no exact nonlinear flow (has_exact_nonlinear_flow() is false)");
+}
+
 double Model::oscillatory_energy(const Vector& u) const {
   Vector mu(u.size());
   apply_M(u, mu);

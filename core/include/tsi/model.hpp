@@ -44,6 +44,11 @@ class TSI_API Model {
   /// Energy H(u) = I(u) + H1(u), exactly conserved by the flow.
   double energy(const Vector& u) const { return oscillatory_energy(u) + H1(u); }
 
+  /// True when the model solves u' = J grad H1(u) exactly (splitting schemes need it).
+  virtual bool has_exact_nonlinear_flow() const { return false; }
+  /// u <- the exact flow of u' = J grad H1(u) over time t. The default throws tsi::Error.
+  virtual void nonlinear_flow(double t, Vector& u) const;
+
   /// The model's default initial value u0 (model variables).
   virtual Vector initial_value() const = 0;
   /// Model variables from a user-given initial value in physical variables (identity by default).

@@ -30,6 +30,13 @@ class TSI_API Problem {
   /// out = L y + N(t, y).
   virtual void rhs(double t, const Vector& y, Vector& out) = 0;
 
+  /// True when linear_flow and nonlinear_flow are available (splitting schemes need them).
+  virtual bool has_exact_flows() const { return false; }
+  /// y <- e^{hL} y. The default throws tsi::Error.
+  virtual void linear_flow(double h, Vector& y);
+  /// y <- the exact flow of y' = N(t, y) from t to t + h. The default throws tsi::Error.
+  virtual void nonlinear_flow(double t, double h, Vector& y);
+
   /// Evaluations of N (or of rhs) since construction: the work measure of a run.
   long evaluations() const { return evaluations_; }
 

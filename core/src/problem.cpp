@@ -1,0 +1,15 @@
+#include "tsi/problem.hpp"
+
+#include "tsi/error.hpp"
+
+namespace tsi {
+
+void Problem::linear_flow(double /*h*/, Vector& /*y*/) {
+  throw Error("this problem has no exact linear flow (has_exact_flows() is false)");
+}
+
+void Problem::nonlinear_flow(double /*t*/, double /*h*/, Vector& /*y*/) {
+  throw Error("this problem has no exact nonlinear flow (has_exact_flows() is false)");
+}
+
+}  // namespace tsi
