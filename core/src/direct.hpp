@@ -1,4 +1,5 @@
 #pragma once
+#include "tsi/phase.hpp"
 #include "tsi/reformulation.hpp"
 
 namespace tsi {
@@ -18,7 +19,7 @@ class Direct final : public Reformulation {
 
   /// Exact flows when the model has an exact nonlinear flow: e^{hL} = e^{JM h/eps}.
   bool has_exact_flows() const override { return model_->has_exact_nonlinear_flow(); }
-  void linear_flow(double h, Vector& y) override { y = model_->linear_flow(h / model_->eps(), y); }
+  void linear_flow(double h, Vector& y) override { y = model_->linear_flow(fast_phase(h, model_->eps()), y); }
   void nonlinear_flow(double /*t*/, double h, Vector& y) override { model_->nonlinear_flow(h, y); }
 
   Vector prepare(const Vector& u0) override { return u0; }
