@@ -12,8 +12,8 @@
 namespace tsi::app {
 namespace {
 
-const std::vector<std::string> sections = {"model",     "reformulation", "scheme", "time",
-                                           "reference", "output",        "plugins"};
+const std::vector<std::string> sections = {"model",  "reformulation", "scheme",  "time",
+                                           "reference", "output", "monitor", "plugins"};
 
 std::string join(const std::vector<std::string>& names) {
   std::string out;
@@ -65,6 +65,16 @@ const ParamSchema& output_schema() {
   static const ParamSchema schema = {
       integer_param("every", 1, "write a row of invariants.csv every this many steps")
           .check([](const Json& v) { return v.get<long>() >= 1; }, "a positive integer")};
+  return schema;
+}
+
+const ParamSchema& monitor_schema() {
+  static const ParamSchema schema = {
+      number_param("max_err_H", 10.0, "stop the run (blow-up) when err_H exceeds this")
+          .range(0.0, std::numeric_limits<double>::infinity(), true),
+      number_param("tau_roughness_warn", 1e-10,
+                   "warn when this fraction of the energy of U is in the top quarter of the tau spectrum")
+          .range(0.0, 1.0, true)};
   return schema;
 }
 
@@ -174,6 +184,7 @@ Json resolve_run_config(const Json& raw, const Registry& registry) {
   }
 
   out["output"] = resolve_params(output_schema(), section_object(raw, "output", empty), "output");
+  out["monitor"] = resolve_params(monitor_schema(), section_object(raw, "monitor", empty), "monitor");
 
   out["plugins"] = Json::array();
   if (raw.contains("plugins")) {

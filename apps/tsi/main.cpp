@@ -42,7 +42,7 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
   tsi::app::write_run_files(out_dir, outcome);
   fmt::print("{}", tsi::app::run_summary(outcome, out_dir));
   if (!outcome.ok) {
-    spdlog::error("run failed: {}", outcome.message);
+    spdlog::error("run {}: {}", outcome.result.value("status", std::string("failed")), outcome.message);
     return 1;
   }
   return 0;

@@ -7,6 +7,8 @@
 #include <limits>
 
 #include "config.hpp"
+#include "run_recorder.hpp"
+#include "tsi/phase.hpp"
 #include "tsi/driver.hpp"
 #include "tsi/error.hpp"
 #include "tsi/version.hpp"
@@ -18,11 +20,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// |X - X0| / |X0| (absolute when X0 = 0).
-double relative_change(double value, double initial) {
-  return std::abs(value - initial) / (initial != 0.0 ? std::abs(initial) : 1.0);
 }
 
 Vector initial_value(const Model& model, const Json& model_config) {
@@ -43,11 +40,6 @@ Vector initial_value(const Model& model, const Json& model_config) {
   }
   return model.from_physical(x);
 }
-
-struct InvariantTrack {
-  double initial = 0.0, final = 0.0, max_rel_error = 0.0;
-  Json to_json() const { return {{"initial", initial}, {"final", final}, {"max_rel_error", max_rel_error}}; }
-};
 
 // The reference solution at t_end, computed by another scheme on another reformulation.
 Vector reference_solution(const Json& config, const Json& ref, const Registry& registry,
@@ -88,10 +80,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   result["tsi_version"] = version_string;
   result["config"] = config;
   result["warnings"] = Json::array();
-  std::string& csv = outcome.csv;
-  csv = "t,H,I,m,err_H,err_I,err_m,tau_roughness\n";
   const auto start = Clock::now();
-  long steps_done = 0;
   // Construction: bad input (a model's own checks, u0 of the wrong shape) is a ConfigError
   // that propagates before anything runs.
   const ModelEntry& model_entry = registry.model(config["model"]["name"]);
@@ -111,78 +100,69 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
         rconf["initial_data_order"].get<int>()));
   }
 
+  const double h = config["time"]["h"], t_end = config["time"]["t_end"];
+  const long n_steps = step_count(config);
+  RunRecorder recorder(*model, *reformulation, u0, config);
+  std::string status = "completed";
+  auto last_progress = Clock::now();
   try {
-    const double h = config["time"]["h"], t_end = config["time"]["t_end"];
-    const long n_steps = step_count(config);
-    const long every = config["output"]["every"];
-
-    InvariantTrack H{model->energy(u0)}, I{model->oscillatory_energy(u0)}, m{model->mass(u0)};
-    double roughness_max = 0.0;
     Vector y = reformulation->prepare(u0);
-    Vector u = u0;
-    auto last_progress = Clock::now();
-
     integrate(*reformulation, *stepper, y, h, n_steps, [&](long n, double t, const Vector& state) {
-      steps_done = n;
-      u = reformulation->read_back(state, t);
-      const double values[3] = {model->energy(u), model->oscillatory_energy(u), model->mass(u)};
-      InvariantTrack* tracks[3] = {&H, &I, &m};
-      double errors[3];
-      for (int k = 0; k < 3; ++k) {
-        if (!std::isfinite(values[k]))
-          throw Error(fmt::format("the solution became non-finite at t = {} (step {})", t, n));
-        errors[k] = relative_change(values[k], tracks[k]->initial);
-        tracks[k]->final = values[k];
-        tracks[k]->max_rel_error = std::max(tracks[k]->max_rel_error, errors[k]);
-      }
-      const double roughness = reformulation->tau_roughness(state);
-      roughness_max = std::max(roughness_max, roughness);
-      if (n % every == 0 || n == n_steps)
-        csv += fmt::format("{:.17g},{:.17g},{:.17g},{:.17g},{:.6e},{:.6e},{:.6e},{:.6e}\n", t, values[0],
-                           values[1], values[2], errors[0], errors[1], errors[2], roughness);
+      const bool go_on = recorder.observe(n, t, state);
       if (progress && seconds_since(last_progress) > 0.5) {
         progress(static_cast<double>(n) / static_cast<double>(std::max(1L, n_steps)));
         last_progress = Clock::now();
       }
-      return true;
+      return go_on;
     });
-    const double wall = seconds_since(start);
-
-    const Vector x = model->to_physical(u);
-    result["status"] = "completed";
-    result["steps"] = n_steps;
-    result["t_end"] = t_end;
-    result["u_final"] = state_to_json(x, model->is_complex());
-    result["invariants"] = {{"H", H.to_json()}, {"I", I.to_json()}, {"m", m.to_json()}};
-    const SolverStats stats = stepper->stats();
-    result["solver"] = {{"iterations_mean", stats.iterations_mean()},
-                        {"iterations_max", stats.iterations_max},
-                        {"not_converged", stats.not_converged},
-                        {"stages", stats.solves}};
-    if (stats.not_converged > 0)
-      result["warnings"].push_back(fmt::format("{} implicit stages did not converge to tol within max_iter",
-                                               stats.not_converged));
-    result["rhs_evaluations"] = reformulation->evaluations();
-    result["tau_roughness_max"] = roughness_max;
-    result["wall_seconds"] = wall;
-
-    if (config.contains("reference")) {
-      const auto ref_start = Clock::now();
-      const Vector ref = model->to_physical(reference_solution(config, config["reference"], registry, model, u0));
-      Json error = {{"relative", model->error_norm(x - ref) / model->error_norm(ref)},
-                    {"absolute", model->error_norm(x - ref)},
-                    {"reference", config["reference"]}};
-      error["reference"]["wall_seconds"] = seconds_since(ref_start);
-      error["reference"]["u_final"] = state_to_json(ref, model->is_complex());
-      result["error"] = error;
+    if (recorder.status() != "running") {
+      status = recorder.status();
+      outcome.message = recorder.message();
     }
   } catch (const std::exception& e) {
-    outcome.ok = false;
-    outcome.message = e.what();
-    result["status"] = "failed";
-    result["message"] = e.what();
-    result["steps"] = steps_done;
-    result["wall_seconds"] = seconds_since(start);
+    status = "failed";
+    outcome.message = fmt::format("at t = {:.6g} (step {}): {}", step_time(recorder.steps(), h),
+                                  recorder.steps() + 1, e.what());
+  }
+  const double wall = seconds_since(start);
+
+  // Everything up to where the run stopped is kept, whatever the status.
+  outcome.ok = status == "completed";
+  outcome.csv = recorder.csv();
+  result["status"] = status;
+  if (!outcome.ok) result["message"] = outcome.message;
+  const Vector x = model->to_physical(recorder.u_last());
+  result["steps"] = recorder.steps();
+  result["t_end"] = t_end;
+  result["t_reached"] = recorder.t_reached();
+  result["u_final"] = state_to_json(x, model->is_complex());
+  result["invariants"] = recorder.invariants_json();
+  const SolverStats stats = stepper->stats();
+  Json histogram = Json::object();
+  for (size_t k = 0; k < stats.sweeps_histogram.size(); ++k)
+    if (stats.sweeps_histogram[k] > 0) histogram[std::to_string(k)] = stats.sweeps_histogram[k];
+  result["solver"] = {{"iterations_mean", stats.iterations_mean()},
+                      {"iterations_max", stats.iterations_max},
+                      {"not_converged", stats.not_converged},
+                      {"stages", stats.solves},
+                      {"sweeps_histogram", histogram}};
+  for (const auto& w : recorder.warnings()) result["warnings"].push_back(w);
+  if (stats.not_converged > 0)
+    result["warnings"].push_back(fmt::format("{} implicit stages did not converge to tol within max_iter",
+                                             stats.not_converged));
+  result["rhs_evaluations"] = reformulation->evaluations();
+  result["tau_roughness_max"] = recorder.roughness_max();
+  result["wall_seconds"] = wall;
+
+  if (outcome.ok && config.contains("reference")) {
+    const auto ref_start = Clock::now();
+    const Vector ref = model->to_physical(reference_solution(config, config["reference"], registry, model, u0));
+    Json error = {{"relative", model->error_norm(x - ref) / model->error_norm(ref)},
+                  {"absolute", model->error_norm(x - ref)},
+                  {"reference", config["reference"]}};
+    error["reference"]["wall_seconds"] = seconds_since(ref_start);
+    error["reference"]["u_final"] = state_to_json(ref, model->is_complex());
+    result["error"] = error;
   }
   return outcome;
 }

@@ -13,9 +13,10 @@ std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
                    c["scheme"]["name"].get<std::string>(), c["reformulation"]["name"].get<std::string>());
   s += fmt::format("  h = {:g}, t_end = {:g}, steps = {}\n", c["time"]["h"].get<double>(),
                    c["time"]["t_end"].get<double>(), r.value("steps", 0L));
-  if (!outcome.ok) {
-    s += fmt::format("  FAILED: {}\n", outcome.message);
-  } else {
+  if (!outcome.ok) s += fmt::format("  {}: {}\n", r["status"].get<std::string>(), outcome.message);
+  if (r.contains("invariants")) {
+    if (r.contains("t_reached") && !outcome.ok)
+      s += fmt::format("  reached t = {:g} after {} steps\n", r["t_reached"].get<double>(), r["steps"].get<long>());
     if (r.contains("error"))
       s += fmt::format("  relative error at t_end   {:.3e}   (reference {} on {}, tol {:g})\n",
                        r["error"]["relative"].get<double>(), r["error"]["reference"]["scheme"].get<std::string>(),

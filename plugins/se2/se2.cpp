@@ -18,17 +18,27 @@ using tsi::Vector;
 
 class Se2 final : public tsi::Stepper {
  public:
-  Se2(tsi::FixedPointOptions options, int nodes) : solver_(options), rule_(tsi::gauss_legendre(nodes)) {}
+  Se2(const tsi::FixedPointOptions& options, int nodes)
+      : solver_(tsi::make_fixed_point_solver(options)),
+        guess_previous_(options.guess == "previous"),
+        rule_(tsi::gauss_legendre(nodes)) {}
+
+  void reset() override { have_previous_ = false; }
 
   void step(tsi::Problem& problem, double t, double h, Vector& y) override {
     if (h != h_ || problem.size() != e_.size()) {
       tsi::diagonal_function(problem.linear_multipliers(), h, [](Complex z) { return std::exp(z); }, e_);
       tsi::diagonal_function(problem.linear_multipliers(), h, [h](Complex z) { return h * tsi::phi1(z); }, b_);
       h_ = h;
+      have_previous_ = false;
     }
     base_ = e_.cwiseProduct(y);
-    next_ = base_;
-    solver_.solve(next_, [&](const Vector& x, Vector& out) {
+    // Starting guess: the previous step's averaged N, an O(h^2) predictor.
+    if (guess_previous_ && have_previous_)
+      next_ = base_ + b_.cwiseProduct(average_);
+    else
+      next_ = base_;
+    solver_->solve(next_, [&](const Vector& x, Vector& out) {
       average_.setZero(y.size());
       for (size_t i = 0; i < rule_.nodes.size(); ++i) {
         const double rho = rule_.nodes[i];
@@ -39,12 +49,15 @@ class Se2 final : public tsi::Stepper {
       out = base_ + b_.cwiseProduct(average_);
     });
     y = next_;
+    have_previous_ = true;
   }
 
-  tsi::SolverStats stats() const override { return solver_.stats(); }
+  tsi::SolverStats stats() const override { return solver_->stats(); }
 
  private:
-  tsi::FixedPointSolver solver_;
+  std::unique_ptr<tsi::FixedPointSolver> solver_;
+  bool guess_previous_;
+  bool have_previous_ = false;
   tsi::QuadratureRule rule_;
   double h_ = std::numeric_limits<double>::quiet_NaN();
   Vector e_, b_, base_, next_, stage_, n_, average_;

@@ -282,31 +282,104 @@ TEST_CASE("run: t_end = 0 is zero steps and one row at t = 0") {
   CHECK(lines.size() == 2);
 }
 
-TEST_CASE("run: a run that fails part-way exits 1 and still writes its files") {
-  // Explicit Euler (the fixture scheme) on the stiff direct problem with h / eps = 100:
-  // the solution grows by about 100 per step and overflows within 200 steps.
+// Explicit Euler (the fixture scheme) on the stiff direct problem with h / eps = 100: the
+// solution grows by about 100 per step.
+Json blowing_up_config() {
+  return {{"plugins", {fixture_plugin("good")}},
+          {"model", {{"name", "fixture-model"}, {"eps", 0.01}}},
+          {"scheme", {{"name", "fixture-scheme"}}},
+          {"reformulation", {{"name", "direct"}}},
+          {"time", {{"h", 1.0}, {"t_end", 400.0}}}};
+}
+
+TEST_CASE("run: err_H above monitor.max_err_H stops the run, which keeps its files") {
   TempDir dir;
-  const Json config = {{"plugins", {fixture_plugin("good")}},
-                       {"model", {{"name", "fixture-model"}, {"eps", 0.01}}},
-                       {"scheme", {{"name", "fixture-scheme"}}},
-                       {"reformulation", {{"name", "direct"}}},
-                       {"time", {{"h", 1.0}, {"t_end", 400.0}}}};
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", write_config(dir, blowing_up_config()), "--out", out});
+  INFO(r.describe());
+  CHECK(r.exit_code == 1);
+  CHECK(r.signal == 0);
+  CHECK(contains(r.err, "monitor.max_err_H = 10"));
+  const Json result = read_json(fs::path(out) / "result.json");
+  CHECK(result.at("status") == "blow-up");
+  CHECK(contains(result.at("message").get<std::string>(), "at t = 1 (step 1)"));
+  CHECK(result.at("steps").get<long>() == 1);
+  CHECK(result.at("t_reached").get<double>() == 1.0);
+  CHECK(result.at("invariants").at("H").at("max_rel_error").get<double>() > 10.0);
+  const auto lines = lines_of(read_text(fs::path(out) / "invariants.csv"));
+  CHECK(lines.size() == 3);  // header, t = 0, and the step that crossed the bound
+}
+
+TEST_CASE("run: a non-finite solution stops the run at once, keeping everything before it") {
+  TempDir dir;
+  Json config = blowing_up_config();
+  config["monitor"] = {{"max_err_H", 1.7e308}};  // near DBL_MAX: only overflow stops it
   const std::string out = dir / "out";
   const CommandResult r = run_tsi({"run", write_config(dir, config), "--out", out});
   INFO(r.describe());
   CHECK(r.exit_code == 1);
   CHECK(r.signal == 0);
   CHECK(contains(r.err, "non-finite"));
-  REQUIRE(fs::is_regular_file(fs::path(out) / "result.json"));
-  REQUIRE(fs::is_regular_file(fs::path(out) / "invariants.csv"));
   const Json result = read_json(fs::path(out) / "result.json");
-  CHECK(result.at("status") == "failed");
+  CHECK(result.at("status") == "blow-up");
   CHECK(contains(result.at("message").get<std::string>(), "non-finite"));
-  CHECK(result.at("steps").get<long>() > 0);
-  CHECK(result.at("steps").get<long>() < 400);
+  const long steps = result.at("steps").get<long>();
+  CHECK(steps > 1);
+  CHECK(steps < 400);
+  for (const auto& x : result.at("u_final")) CHECK(std::isfinite(x.get<double>()));
   const auto lines = lines_of(read_text(fs::path(out) / "invariants.csv"));
   CHECK(lines.at(0) == "t,H,I,m,err_H,err_I,err_m,tau_roughness");
-  CHECK(lines.size() > 2);
+  CHECK(static_cast<long>(lines.size()) == steps + 2);  // header and t_0 .. t_steps
+}
+
+TEST_CASE("run: a roughening tau profile is reported, and its maximum recorded") {
+  // Henon-Heiles at eps = 1 over T = 200: the high tau modes of U grow (SPEC.md section 4).
+  TempDir dir;
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", example_config(), "--out", out, "--set", "model.eps=1",
+                                   "--set", "time.h=0.2", "--set", "time.t_end=200", "--set", "reference=null"});
+  INFO(r.describe());
+  CHECK(r.exit_code == 0);
+  CHECK(contains(r.out, "the tau profile roughened"));
+  const Json result = read_json(fs::path(out) / "result.json");
+  CHECK(result.at("tau_roughness_max").get<double>() > 1e-10);
+  // The same problem at eps = 0.01 stays resolved: no warning.
+  const CommandResult smooth = run_tsi({"run", example_config(), "--out", out, "--set", "time.h=0.2",
+                                        "--set", "time.t_end=200", "--set", "reference=null"});
+  CHECK(smooth.exit_code == 0);
+  CHECK_FALSE(contains(smooth.out, "roughened"));
+  CHECK(read_json(fs::path(out) / "result.json").at("tau_roughness_max").get<double>() < 1e-20);
+}
+
+TEST_CASE("run: per-step solver statistics, and the stop policy for an unconverged stage") {
+  TempDir dir;
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", example_config(), "--out", out, "--set", "reference=null"});
+  REQUIRE(r.exit_code == 0);
+  const Json solver = read_json(fs::path(out) / "result.json").at("solver");
+  long stages = 0, sweeps = 0;
+  for (const auto& [k, count] : solver.at("sweeps_histogram").items()) {
+    stages += count.get<long>();
+    sweeps += std::stol(k) * count.get<long>();
+  }
+  CHECK(stages == solver.at("stages").get<long>());
+  CHECK(static_cast<double>(sweeps) / static_cast<double>(stages) ==
+        doctest::Approx(solver.at("iterations_mean").get<double>()));
+
+  const CommandResult warn = run_tsi({"run", example_config(), "--out", out, "--set", "reference=null",
+                                      "--set", "scheme.max_iter=2"});
+  CHECK(warn.exit_code == 0);
+  CHECK(contains(warn.out, "did not converge"));
+  CHECK(read_json(fs::path(out) / "result.json").at("solver").at("not_converged").get<long>() == 8);
+
+  const CommandResult stop = run_tsi({"run", example_config(), "--out", out, "--set", "reference=null",
+                                      "--set", "scheme.max_iter=2", "--set", "scheme.on_failure=stop"});
+  INFO(stop.describe());
+  CHECK(stop.exit_code == 1);
+  const Json result = read_json(fs::path(out) / "result.json");
+  CHECK(result.at("status") == "failed");
+  CHECK(contains(result.at("message").get<std::string>(), "at t = 0 (step 1)"));
+  CHECK(contains(result.at("message").get<std::string>(), "max_iter = 2"));
 }
 
 }  // TEST_SUITE

@@ -1,55 +1,59 @@
 #pragma once
+#include <memory>
+#include <string>
+
 #include "tsi/export.hpp"
+#include "tsi/function_ref.hpp"
 #include "tsi/params.hpp"
 #include "tsi/stepper.hpp"
 #include "tsi/types.hpp"
 
 namespace tsi {
 
-/// Settings of a fixed-point (Picard) iteration x = G(x).
+/// Settings of the fixed-point iteration x = G(x) of an implicit stage.
 struct TSI_API FixedPointOptions {
-  double tol = 1e-10;  ///< stop when max|x_{k+1} - x_k| <= tol * max|x_{k+1}|
-  int max_iter = 200;  ///< give up (and count a failure) after this many sweeps
+  std::string method = "picard";  ///< "picard" or "anderson"
+  double tol = 1e-10;              ///< stop when max|G(x) - x| <= tol * max|G(x)|
+  int max_iter = 200;              ///< sweeps (evaluations of G) before giving up
+  int anderson_depth = 3;          ///< Anderson: how many previous residuals to mix
+  std::string on_failure = "warn"; ///< "warn": count and continue; "stop": throw tsi::Error
+  std::string guess = "previous";  ///< starting guess of the scheme: "previous" step's stage, or "linear" part only
 };
 
-/// The parameters every implicit scheme takes for its fixed-point iteration: tol, max_iter.
+/// The parameters every implicit scheme takes for its fixed-point iteration.
 TSI_API ParamSchema fixed_point_params();
 /// FixedPointOptions from resolved parameters that include fixed_point_params().
 TSI_API FixedPointOptions fixed_point_options(const Params& params);
 
-/// Solves x = G(x) by Picard iteration and keeps the statistics a run reports.
+/// The right-hand side of x = G(x): g(x, out) writes G(x) into out.
+using FixedPointMap = FunctionRef<void(const Vector&, Vector&)>;
+
+/// Solves x = G(x) from a starting guess and keeps the statistics a run reports
+/// (a swappable part, as SUNDIALS' nonlinear solver objects). Allocates only on the first
+/// solve of a given size.
 class TSI_API FixedPointSolver {
  public:
-  explicit FixedPointSolver(FixedPointOptions options = {}) : options_(options) {}
+  explicit FixedPointSolver(FixedPointOptions options);
+  virtual ~FixedPointSolver() = default;
 
-  /// Iterates from the guess in x; g(x, out) writes G(x) into out. Returns true when the
-  /// increment test passed, false when max_iter sweeps did not reach tol (x holds the last
-  /// iterate and the failure is counted).
-  template <class G>
-  bool solve(Vector& x, G&& g) {
-    next_.resize(x.size());
-    for (int k = 1; k <= options_.max_iter; ++k) {
-      g(x, next_);
-      const double increment = (next_ - x).cwiseAbs().maxCoeff();
-      const double scale = max_norm(next_);
-      x.swap(next_);
-      if (increment <= options_.tol * scale || increment == 0.0) {
-        record(k, true);
-        return true;
-      }
-    }
-    record(options_.max_iter, false);
-    return false;
-  }
+  /// Iterates from the guess in x. Returns true when the increment test passed; on failure
+  /// x holds the last iterate, the failure is counted, and with on_failure = "stop" a
+  /// tsi::Error is thrown.
+  bool solve(Vector& x, FixedPointMap g);
 
   const SolverStats& stats() const { return stats_; }
   const FixedPointOptions& options() const { return options_; }
 
+ protected:
+  /// One solve: returns the number of sweeps, or -1 when max_iter did not reach tol.
+  virtual int iterate(Vector& x, FixedPointMap g, double& increment) = 0;
+
  private:
-  void record(int sweeps, bool converged);
   FixedPointOptions options_;
   SolverStats stats_;
-  Vector next_;
 };
+
+/// The solver the options ask for (Picard or Anderson).
+TSI_API std::unique_ptr<FixedPointSolver> make_fixed_point_solver(const FixedPointOptions& options);
 
 }  // namespace tsi

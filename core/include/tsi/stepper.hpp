@@ -26,6 +26,7 @@ struct TSI_API SolverStats {
   long iterations = 0;      ///< fixed-point sweeps in total
   long iterations_max = 0;  ///< most sweeps one stage took
   long not_converged = 0;   ///< stages that hit max_iter without reaching tol
+  std::vector<long> sweeps_histogram;  ///< entry k: stages that took k sweeps
   double iterations_mean() const { return solves ? double(iterations) / double(solves) : 0.0; }
 };
 

@@ -1,0 +1,81 @@
+#include "run_recorder.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "config.hpp"
+
+namespace tsi::app {
+namespace {
+// |X - X0| / |X0| (absolute when X0 = 0).
+double relative_change(double value, double initial) {
+  return std::abs(value - initial) / (initial != 0.0 ? std::abs(initial) : 1.0);
+}
+}  // namespace
+
+RunRecorder::RunRecorder(const Model& model, Reformulation& reformulation, const Vector& u0,
+                         const Json& config)
+    : model_(model),
+      reformulation_(reformulation),
+      every_(config["output"]["every"]),
+      n_steps_(step_count(config)),
+      max_err_H_(config["monitor"]["max_err_H"]),
+      roughness_warn_(config["monitor"]["tau_roughness_warn"]),
+      u_(u0),
+      csv_("t,H,I,m,err_H,err_I,err_m,tau_roughness\n") {
+  const double initial[3] = {model.energy(u0), model.oscillatory_energy(u0), model.mass(u0)};
+  for (int k = 0; k < 3; ++k) tracks_[k].initial = tracks_[k].final = initial[k];
+}
+
+bool RunRecorder::observe(long n, double t, const Vector& y) {
+  const Vector u = reformulation_.read_back(y, t);
+  const double values[3] = {model_.energy(u), model_.oscillatory_energy(u), model_.mass(u)};
+  if (!u.allFinite() || !std::isfinite(values[0] + values[1] + values[2])) {
+    status_ = "blow-up";
+    message_ = fmt::format("the solution became non-finite at t = {:.6g} (step {})", t, n);
+    return false;
+  }
+  double errors[3];
+  for (int k = 0; k < 3; ++k) {
+    errors[k] = relative_change(values[k], tracks_[k].initial);
+    tracks_[k].final = values[k];
+    tracks_[k].max_rel_error = std::max(tracks_[k].max_rel_error, errors[k]);
+  }
+  const double roughness = reformulation_.tau_roughness(y);
+  roughness_max_ = std::max(roughness_max_, roughness);
+  if (roughness > roughness_warn_ && !roughness_warned_) {
+    roughness_warned_ = true;
+    warnings_.push_back(fmt::format(
+        "the tau profile roughened at t = {:.6g}: {:.2e} of the energy of U is in the top quarter "
+        "of the tau spectrum (monitor.tau_roughness_warn = {:g}); the run is no longer resolved in "
+        "tau: increase reformulation.n_tau",
+        t, roughness, roughness_warn_));
+  }
+  u_ = u;
+  steps_ = n;
+  t_ = t;
+  const bool blow_up = errors[0] > max_err_H_;
+  if (n % every_ == 0 || n == n_steps_ || blow_up)
+    csv_ += fmt::format("{:.17g},{:.17g},{:.17g},{:.17g},{:.6e},{:.6e},{:.6e},{:.6e}\n", t, values[0],
+                        values[1], values[2], errors[0], errors[1], errors[2], roughness);
+  if (blow_up) {
+    status_ = "blow-up";
+    message_ = fmt::format("err_H = {:.3e} exceeded monitor.max_err_H = {:g} at t = {:.6g} (step {})",
+                           errors[0], max_err_H_, t, n);
+    return false;
+  }
+  return true;
+}
+
+Json RunRecorder::invariants_json() const {
+  Json out;
+  const char* names[3] = {"H", "I", "m"};
+  for (int k = 0; k < 3; ++k)
+    out[names[k]] = {{"initial", tracks_[k].initial},
+                     {"final", tracks_[k].final},
+                     {"max_rel_error", tracks_[k].max_rel_error}};
+  return out;
+}
+
+}  // namespace tsi::app

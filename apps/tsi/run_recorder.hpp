@@ -1,0 +1,50 @@
+#pragma once
+#include <string>
+
+#include "tsi/params.hpp"
+#include "tsi/reformulation.hpp"
+
+namespace tsi::app {
+
+/// What a run records at every step: the invariants H, I, m and their largest relative
+/// changes, the tau roughness, and the rows of invariants.csv. It also watches the run:
+/// a non-finite solution or err_H above monitor.max_err_H stops it (blow-up), and a tau
+/// profile rougher than monitor.tau_roughness_warn is reported once.
+class RunRecorder {
+ public:
+  RunRecorder(const Model& model, Reformulation& reformulation, const Vector& u0, const Json& config);
+
+  /// The step observer: false stops the integration.
+  bool observe(long n, double t, const Vector& y);
+
+  /// Where the run stands: "running", or "blow-up" with a message.
+  const std::string& status() const { return status_; }
+  const std::string& message() const { return message_; }
+  long steps() const { return steps_; }
+  double t_reached() const { return t_; }
+  /// u at the last step whose state was finite (model variables).
+  const Vector& u_last() const { return u_; }
+
+  Json invariants_json() const;
+  double roughness_max() const { return roughness_max_; }
+  const Json& warnings() const { return warnings_; }
+  const std::string& csv() const { return csv_; }
+
+ private:
+  struct Track {
+    double initial = 0.0, final = 0.0, max_rel_error = 0.0;
+  };
+  const Model& model_;
+  Reformulation& reformulation_;
+  long every_, n_steps_;
+  double max_err_H_, roughness_warn_;
+  Track tracks_[3];  // H, I, m
+  Vector u_;
+  long steps_ = 0;
+  double t_ = 0.0, roughness_max_ = 0.0;
+  bool roughness_warned_ = false;
+  std::string status_ = "running", message_, csv_;
+  Json warnings_ = Json::array();
+};
+
+}  // namespace tsi::app

@@ -1,0 +1,23 @@
+#pragma once
+#include "tsi/fixed_point.hpp"
+
+namespace tsi {
+
+/// Anderson acceleration (type II) of the fixed-point map: each update mixes the last
+/// `anderson_depth` residual differences by a least-squares fit. The state is treated as a
+/// real vector (real mixing coefficients), so maps that are not complex-analytic, such as
+/// |u|^2 u, are accelerated correctly.
+class AndersonSolver final : public FixedPointSolver {
+ public:
+  explicit AndersonSolver(FixedPointOptions options);
+
+ protected:
+  int iterate(Vector& x, FixedPointMap g, double& increment) override;
+
+ private:
+  int depth_;
+  Vector gx_, residual_, residual_prev_, gx_prev_;
+  Matrix residual_diffs_, map_diffs_;  // one column per stored difference
+};
+
+}  // namespace tsi

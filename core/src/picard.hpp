@@ -1,0 +1,28 @@
+#pragma once
+#include "tsi/fixed_point.hpp"
+
+namespace tsi {
+
+/// Plain Picard iteration x_{k+1} = G(x_k).
+class PicardSolver final : public FixedPointSolver {
+ public:
+  using FixedPointSolver::FixedPointSolver;
+
+ protected:
+  int iterate(Vector& x, FixedPointMap g, double& increment) override {
+    next_.resize(x.size());
+    for (int k = 1; k <= options().max_iter; ++k) {
+      g(x, next_);
+      const double scale = max_norm(next_);
+      increment = (next_ - x).cwiseAbs().maxCoeff() / (scale > 0.0 ? scale : 1.0);
+      x.swap(next_);
+      if (increment <= options().tol) return k;
+    }
+    return -1;
+  }
+
+ private:
+  Vector next_;
+};
+
+}  // namespace tsi
