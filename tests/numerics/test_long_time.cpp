@@ -1,0 +1,88 @@
+// Near conservation over long times (SPEC.md section 5.3): Henon-Heiles, eps = 0.01,
+// h = 1/5, T = 200. The symmetric schemes keep err_H below 1e-3 with no drift (the
+// least-squares slope of err_H over [20, 200], times the window, within the residual
+// noise); the others drift, and their max err_H is at least 10 times larger.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "harness.hpp"
+
+namespace {
+
+using tsi::Vector;
+using tsi::test::Harness;
+
+struct EnergyRecord {
+  std::vector<double> t, err_H;
+};
+
+EnergyRecord energy_error(const tsi::SchemeEntry& scheme) {
+  auto& h = Harness::instance();
+  auto model = h.model("henon-heiles", 0.01);
+  auto two_scale = h.reformulation("two-scale", model,
+                                   {{"n_tau", 64}, {"initial_data_order", std::max(1, scheme.traits.initial_data_order)}});
+  auto stepper = h.scheme(scheme.info.name);
+  const Vector u0 = model->initial_value();
+  const double H0 = model->energy(u0);
+  Vector y = two_scale->prepare(u0);
+  EnergyRecord record;
+  tsi::integrate(*two_scale, *stepper, y, 0.2, 1000, [&](long, double t, const Vector& state) {
+    record.t.push_back(t);
+    record.err_H.push_back(std::abs(model->energy(two_scale->read_back(state, t)) - H0) / std::abs(H0));
+    return true;
+  });
+  return record;
+}
+
+struct Drift {
+  double over_window;  // least-squares slope times the window length
+  double noise;        // standard deviation of the residual about the line
+};
+
+Drift drift(const EnergyRecord& r, double from) {
+  double n = 0, st = 0, se = 0, stt = 0, ste = 0;
+  for (size_t i = 0; i < r.t.size(); ++i) {
+    if (r.t[i] < from) continue;
+    n += 1, st += r.t[i], se += r.err_H[i], stt += r.t[i] * r.t[i], ste += r.t[i] * r.err_H[i];
+  }
+  const double slope = (n * ste - st * se) / (n * stt - st * st), intercept = (se - slope * st) / n;
+  double ss = 0;
+  for (size_t i = 0; i < r.t.size(); ++i)
+    if (r.t[i] >= from) ss += std::pow(r.err_H[i] - intercept - slope * r.t[i], 2);
+  return {slope * (r.t.back() - from), std::sqrt(ss / n)};
+}
+
+}  // namespace
+
+TEST_CASE("long time: symmetric schemes conserve energy without drift, the others drift") {
+  double symmetric_max = 0.0;
+  std::vector<std::pair<std::string, double>> others;
+  for (const auto* scheme : Harness::instance().registry().schemes()) {
+    const auto& r = scheme->traits.reformulations;
+    if (std::find(r.begin(), r.end(), "two-scale") == r.end()) continue;
+    const EnergyRecord record = energy_error(*scheme);
+    const double max_err = *std::max_element(record.err_H.begin(), record.err_H.end());
+    const Drift d = drift(record, 20.0);
+    CAPTURE(scheme->info.name);
+    CAPTURE(max_err);
+    CAPTURE(d.over_window);
+    CAPTURE(d.noise);
+    REQUIRE(record.t.size() == 1001);
+    if (scheme->traits.symmetric) {
+      CHECK(max_err < 1e-3);
+      CHECK(std::abs(d.over_window) < d.noise);  // no drift beyond the oscillation
+      symmetric_max = std::max(symmetric_max, max_err);
+    } else {
+      CHECK(d.over_window > 10.0 * d.noise);  // a drift well above the oscillation
+      others.emplace_back(scheme->info.name, max_err);
+    }
+  }
+  REQUIRE(symmetric_max > 0.0);
+  REQUIRE_FALSE(others.empty());
+  for (const auto& [name, max_err] : others) {
+    CAPTURE(name);
+    CHECK(max_err >= 10.0 * symmetric_max);
+  }
+}
