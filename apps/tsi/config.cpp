@@ -143,8 +143,10 @@ Json resolve_run_config(const Json& raw, const Registry& registry) {
 
   const Json& scheme = section_object(raw, "scheme", empty);
   const SchemeEntry& scheme_entry = registry.scheme(name_of(scheme, "scheme", "se1"));
-  out["scheme"] = with_name(scheme_entry.info.name,
-                            resolve_params(scheme_entry.info.params, without_name(scheme), "scheme"));
+  Json sparams = resolve_params(scheme_entry.info.params, without_name(scheme), "scheme");
+  if (sparams.contains("quadrature_nodes") && sparams["quadrature_nodes"].is_null())
+    sparams["quadrature_nodes"] = default_quadrature_nodes(model_entry);
+  out["scheme"] = with_name(scheme_entry.info.name, sparams);
 
   const Json& reformulation = section_object(raw, "reformulation", empty);
   const auto& supported = scheme_entry.traits.reformulations;

@@ -7,6 +7,10 @@
 
 namespace tsi {
 
+int default_quadrature_nodes(const ModelEntry& model) {
+  return model.nonlinearity_degree > 0 ? (model.nonlinearity_degree + 2) / 2 : 6;
+}
+
 void register_core(Registry& registry) {
   const auto previous = registry.provider();
   registry.set_provider("core");

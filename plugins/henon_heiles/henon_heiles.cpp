@@ -78,6 +78,7 @@ void register_henon_heiles(tsi::Registry& registry) {
   entry.info.aliases = {"hh"};
   entry.info.summary = "Henon-Heiles with a fast (q1, p1) oscillator (eq. HH model), dim 4";
   entry.default_n_tau = 64;
+  entry.nonlinearity_degree = 2;
   entry.create = [](const tsi::Params& p) { return std::make_unique<HenonHeiles>(p.number("eps")); };
   registry.add_model(std::move(entry));
 }

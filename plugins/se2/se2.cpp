@@ -70,8 +70,9 @@ void register_se2(tsi::Registry& registry) {
   entry.info.summary = "SE2-TSI: symmetric exponential average-vector-field scheme (eq. S2)";
   entry.info.params = tsi::fixed_point_params();
   entry.info.params.push_back(
-      tsi::integer_param("quadrature_nodes", 2,
-                         "Gauss-Legendre nodes for the rho-integral (2: exact for cubic N)")
+      tsi::integer_param("quadrature_nodes", nullptr,
+                         "Gauss-Legendre nodes for the rho-integral; default: exact for the model's "
+                         "polynomial nonlinearity (2 for quadratic and cubic), 6 otherwise")
           .check([](const tsi::Json& v) { return v.get<long>() >= 1 && v.get<long>() <= 64; },
                  "an integer from 1 to 64"));
   entry.traits.order = 2;
@@ -81,7 +82,8 @@ void register_se2(tsi::Registry& registry) {
   entry.traits.initial_data_order = 2;
   entry.traits.reformulations = {"filtered", "two-scale"};
   entry.create = [](const tsi::Params& p) {
-    return std::make_unique<Se2>(tsi::fixed_point_options(p), static_cast<int>(p.integer("quadrature_nodes")));
+    const int nodes = p.has("quadrature_nodes") ? static_cast<int>(p.integer("quadrature_nodes")) : 2;
+    return std::make_unique<Se2>(tsi::fixed_point_options(p), nodes);
   };
   registry.add_scheme(std::move(entry));
 }

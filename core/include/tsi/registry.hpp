@@ -30,6 +30,9 @@ using StepperFactory = std::function<std::unique_ptr<Stepper>(const Params&)>;
 struct TSI_API ModelEntry {
   EntryInfo info;
   int default_n_tau = 64;  ///< tau resolution for the two-scale reformulation (SPEC.md sec. 4)
+  /// Degree of J grad H1 as a polynomial in u (Henon-Heiles 2, NLS 3), 0 if not polynomial:
+  /// sets the Gauss-Legendre nodes of average-vector-field schemes (quadrature_nodes).
+  int nonlinearity_degree = 0;
   ModelFactory create;
 };
 
@@ -89,6 +92,10 @@ class TSI_API Registry {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// Gauss-Legendre nodes that integrate the model's nonlinearity along a segment exactly
+/// (degree d needs (d + 2) / 2 nodes); 6 for a non-polynomial one.
+TSI_API int default_quadrature_nodes(const ModelEntry& model);
 
 /// Registers the three reformulations of the core (two-scale, filtered, direct).
 TSI_API void register_core(Registry& registry);
