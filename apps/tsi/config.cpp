@@ -57,7 +57,10 @@ const ParamSchema& reference_schema() {
       string_param("reformulation", "filtered", "the problem the reference solver integrates"),
       number_param("tol", 1e-13, "the reference solver's tolerance").range(1e-16, 1e-1),
       number_param("h", nullptr, "step of a non-adaptive reference solver; default: t_end")
-          .range(0.0, std::numeric_limits<double>::infinity(), true)};
+          .range(0.0, std::numeric_limits<double>::infinity(), true),
+      bool_param("estimate_accuracy", true,
+                 "estimate the reference's own error by a second run at tol / 10 and twice the "
+                 "substeps per fast period")};
   return schema;
 }
 

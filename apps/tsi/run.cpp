@@ -41,27 +41,53 @@ Vector initial_value(const Model& model, const Json& model_config) {
   return model.from_physical(x);
 }
 
-// The reference solution at t_end, computed by another scheme on another reformulation.
-Vector reference_solution(const Json& config, const Json& ref, const Registry& registry,
-                          std::shared_ptr<const Model> model, const Vector& u0) {
+// The reference's final state in model variables, with its scheme's tolerance scaled by
+// `tol_factor` and its substeps per fast period by `substep_factor`.
+Vector reference_state(const Json& config, const Registry& registry, double tol_factor, double substep_factor) {
+  const Json& ref = config["reference"];
   const SchemeEntry& scheme = registry.scheme(ref["scheme"], "reference.scheme");
   const ReformulationEntry& reform = registry.reformulation(ref["reformulation"], "reference.reformulation");
+  std::shared_ptr<const Model> model =
+      registry.model(config["model"]["name"]).create(Params(without_name(config["model"])));
   Json scheme_params = Json::object();
-  for (const auto& spec : scheme.info.params)
-    if (spec.name == "tol") scheme_params["tol"] = ref["tol"];
+  for (const auto& spec : scheme.info.params) {
+    if (spec.name == "tol") scheme_params["tol"] = std::max(1e-16, ref["tol"].get<double>() * tol_factor);
+    if (spec.name == "substeps_per_period")
+      scheme_params["substeps_per_period"] = spec.default_value.get<double>() * substep_factor;
+  }
   auto reformulation = reform.create(model, Params(resolve_params(reform.info.params, Json::object(), "reference")));
   auto stepper = scheme.create(Params(resolve_params(scheme.info.params, scheme_params, "reference")));
   const double t_end = config["time"]["t_end"];
-  Vector y = reformulation->prepare(u0);
+  Vector y = reformulation->prepare(initial_value(*model, config["model"]));
   if (t_end > 0.0) {
-    const double h = ref["h"].is_null() ? t_end : ref["h"].get<double>();
+    const double h = ref["h"].is_null() ? t_end : ref["h"].get<double>() / substep_factor;
     const long steps = std::max(1L, std::lround(t_end / h));
     integrate(*reformulation, *stepper, y, t_end / static_cast<double>(steps), steps, {});
   }
-  return reformulation->read_back(y, t_end);
+  return model->to_physical(reformulation->read_back(y, t_end));
 }
 
 }  // namespace
+
+ReferenceSolution compute_reference(const Json& config, const Registry& registry) {
+  ReferenceSolution out;
+  out.settings = config["reference"];
+  const auto start = Clock::now();
+  out.x = reference_state(config, registry, 1.0, 1.0);
+  out.wall_seconds = seconds_since(start);
+  out.accuracy = std::numeric_limits<double>::quiet_NaN();
+  if (out.settings.value("estimate_accuracy", true)) {
+    const Vector tighter = reference_state(config, registry, 0.1, 2.0);
+    std::shared_ptr<const Model> model =
+        registry.model(config["model"]["name"]).create(Params(without_name(config["model"])));
+    out.accuracy = model->error_norm(out.x - tighter) / model->error_norm(tighter);
+  }
+  return out;
+}
+
+std::string reference_key(const Json& config) {
+  return Json{config["model"], config["time"]["t_end"], config.value("reference", Json())}.dump();
+}
 
 Json state_to_json(const Vector& x, bool complex_state) {
   Json out = Json::array();
@@ -74,7 +100,8 @@ Json state_to_json(const Vector& x, bool complex_state) {
   return out;
 }
 
-RunOutcome execute_run(const Json& config, const Registry& registry, const ProgressFn& progress) {
+RunOutcome execute_run(const Json& config, const Registry& registry, const ProgressFn& progress,
+                       const ReferenceSolution* shared_reference) {
   RunOutcome outcome;
   Json& result = outcome.result;
   result["tsi_version"] = version_string;
@@ -155,13 +182,14 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   result["wall_seconds"] = wall;
 
   if (outcome.ok && config.contains("reference")) {
-    const auto ref_start = Clock::now();
-    const Vector ref = model->to_physical(reference_solution(config, config["reference"], registry, model, u0));
-    Json error = {{"relative", model->error_norm(x - ref) / model->error_norm(ref)},
-                  {"absolute", model->error_norm(x - ref)},
-                  {"reference", config["reference"]}};
-    error["reference"]["wall_seconds"] = seconds_since(ref_start);
-    error["reference"]["u_final"] = state_to_json(ref, model->is_complex());
+    const ReferenceSolution ref = shared_reference ? *shared_reference : compute_reference(config, registry);
+    Json error = {{"relative", model->error_norm(x - ref.x) / model->error_norm(ref.x)},
+                  {"absolute", model->error_norm(x - ref.x)},
+                  {"reference", ref.settings}};
+    error["reference"]["wall_seconds"] = ref.wall_seconds;
+    error["reference"]["estimated_relative_accuracy"] =
+        std::isfinite(ref.accuracy) ? Json(ref.accuracy) : Json(nullptr);
+    error["reference"]["u_final"] = state_to_json(ref.x, model->is_complex());
     result["error"] = error;
   }
   return outcome;

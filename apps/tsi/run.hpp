@@ -15,13 +15,32 @@ struct RunOutcome {
   std::string message;  ///< why the run failed (empty when ok)
 };
 
+/// The reference solution at t_end (physical variables) and how good it is.
+struct ReferenceSolution {
+  Vector x;
+  double wall_seconds = 0.0;
+  /// Relative difference to a second run at tighter settings (tol / 10, twice the substeps
+  /// per fast period): an estimate of the reference's own error. NaN when not estimated.
+  double accuracy = 0.0;
+  Json settings;  ///< the resolved reference section
+};
+
+/// Computes the reference solution a resolved config asks for ("reference" section).
+ReferenceSolution compute_reference(const Json& resolved, const Registry& registry);
+
+/// What identifies a reference: the model section, t_end and the reference section. Runs
+/// with equal keys share one reference.
+std::string reference_key(const Json& resolved);
+
 /// Called now and then with the fraction done, for a progress line.
 using ProgressFn = std::function<void(double fraction)>;
 
 /// Runs a resolved config (resolve_run_config): builds model, reformulation and scheme from
 /// the registry, integrates, records the invariants, and compares with the reference when
-/// one is requested. Errors during the run are caught and reported in the outcome.
-RunOutcome execute_run(const Json& resolved, const Registry& registry, const ProgressFn& progress = {});
+/// one is requested (computing it unless `reference` is given). Errors during the run are
+/// caught and reported in the outcome; bad input (ConfigError) propagates.
+RunOutcome execute_run(const Json& resolved, const Registry& registry, const ProgressFn& progress = {},
+                       const ReferenceSolution* reference = nullptr);
 
 /// The physical state as JSON: real numbers, or [re, im] pairs for a complex model.
 Json state_to_json(const Vector& x, bool complex_state);
