@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
-# The main job: builds tsi and compares schemes side by side on the paper's Henon-Heiles
-# problem (errors and observed orders per eps, cost against a classical solver), with plots.
+# The main job: builds tsi and runs the paper's Henon-Heiles pair side by side for the four
+# two-scale schemes: convergence (errors and observed orders per scheme and eps) and
+# long-time conservation, with tables on the terminal and plots in out/.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+out="${1:-$root/out}"
 "$root/scripts/build.sh"
-/usr/bin/python3 "$root/scripts/compare.py" --tsi "$root/build/bin/tsi" \
-  --study "$root/examples/hh-comparison.json" --out "${1:-$root/out/hh-comparison}"
+"$root/build/bin/tsi" study "$root/examples/paper/hh-convergence.json" --out "$out/hh-convergence"
+echo
+"$root/build/bin/tsi" study "$root/examples/paper/hh-conservation.json" --out "$out/hh-conservation"

@@ -104,23 +104,26 @@ void apply_override(Json& config, const std::string& assignment) {
   } catch (const Json::parse_error&) {
     value = text;  // a bare word is a string
   }
+  assign_path(config, path, value, "--set " + path);
+}
+
+void assign_path(Json& config, const std::string& path, const Json& value, const std::string& origin) {
   std::vector<std::string> keys;
   std::stringstream ss(path);
   for (std::string key; std::getline(ss, key, '.');) {
-    if (key.empty()) throw ConfigError("--set " + path, "empty component in the key path");
+    if (key.empty()) throw ConfigError(origin, "empty component in the key path \"" + path + "\"");
     keys.push_back(key);
   }
+  if (keys.empty()) throw ConfigError(origin, "empty key path");
   if (std::find(sections.begin(), sections.end(), keys.front()) == sections.end())
-    throw ConfigError("--set " + path, "unknown section \"" + keys.front() +
-                                           "\"; valid sections are: " + join(sections));
+    throw ConfigError(origin, "unknown section \"" + keys.front() + "\"; valid sections are: " + join(sections));
   Json* node = &config;
   for (size_t i = 0; i + 1 < keys.size(); ++i) {
-    if (!node->is_object())
-      throw ConfigError("--set " + path, "cannot descend into a value that is not an object");
+    if (!node->is_object()) throw ConfigError(origin, "cannot descend into a value that is not an object");
     node = &(*node)[keys[i]];
     if (node->is_null()) *node = Json::object();
   }
-  if (!node->is_object()) throw ConfigError("--set " + path, "the parent of the key is not an object");
+  if (!node->is_object()) throw ConfigError(origin, "the parent of the key is not an object");
   (*node)[keys.back()] = value;
 }
 

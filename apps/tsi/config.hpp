@@ -9,6 +9,10 @@ namespace tsi::app {
 /// Reads a JSON config file; a missing or malformed file is a ConfigError naming it.
 Json load_config_file(const std::string& path);
 
+/// Sets `value` at a dotted config path, creating objects on the way. The first component
+/// must be a known section; `origin` names where the assignment came from in errors.
+void assign_path(Json& config, const std::string& path, const Json& value, const std::string& origin);
+
 /// Applies one `--set key.path=value` (value parsed as JSON, else taken as a string).
 /// A path through a non-object, or an unknown section, is a ConfigError naming the path.
 void apply_override(Json& config, const std::string& assignment);

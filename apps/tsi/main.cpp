@@ -16,6 +16,7 @@
 #include "plugin_setup.hpp"
 #include "run.hpp"
 #include "run_files.hpp"
+#include "study_command.hpp"
 #include "summary.hpp"
 #include "tsi/error.hpp"
 #include "tsi/version.hpp"
@@ -73,6 +74,17 @@ int main(int argc, char** argv) {
   run->add_option("--out", out_dir, "output directory (default: out/<config name>)");
   run->add_option("--set", overrides, "override a config value: key.path=value (repeatable)");
 
+  auto* study = app.add_subcommand("study", "run a study (a base config and lists of values) in parallel");
+  std::string study_path, study_out;
+  int jobs = 0;
+  bool no_plots = false;
+  std::vector<std::string> study_overrides;
+  study->add_option("study", study_path, "the study file (JSON)")->required();
+  study->add_option("--out", study_out, "output directory (default: out/<study name>)");
+  study->add_option("--jobs,-j", jobs, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  study->add_option("--set", study_overrides, "override a value of the base config: key.path=value");
+  study->add_flag("--no-plots", no_plots, "do not call the plotting script");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -89,6 +101,8 @@ int main(int argc, char** argv) {
                                : tsi::app::list_text(registry, what));
       return 0;
     }
+    if (study->parsed())
+      return tsi::app::study_command(loader, registry, study_path, study_out, jobs, study_overrides, !no_plots);
     return run_command(loader, registry, config_path, out_dir, overrides);
   } catch (const tsi::Error& e) {
     spdlog::error("{}", e.what());

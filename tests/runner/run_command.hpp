@@ -27,6 +27,9 @@ namespace tsi::test {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
+/// Whether `text` contains `part`.
+inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
 /// What a finished child process left behind.
 struct CommandResult {
   int exit_code = -1;  ///< the exit status, or -1 when the process died of a signal

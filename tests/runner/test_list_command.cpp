@@ -9,7 +9,6 @@ namespace {
 
 using namespace tsi::test;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 bool ends_with(const std::string& text, const std::string& tail) { return text.ends_with(tail); }
 

@@ -10,7 +10,6 @@ namespace {
 
 using namespace tsi::test;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 Json entry_named(const Json& entries, const std::string& name) {
   for (const auto& e : entries)

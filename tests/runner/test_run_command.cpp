@@ -19,7 +19,6 @@ double henon_heiles_energy(double q1, double q2, double p1, double p2, double ep
   return oscillatory + h1;
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 }  // namespace
 

@@ -11,7 +11,6 @@ namespace {
 
 using namespace tsi::test;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 /// Checks a bad-input outcome: exit code 2, the "tsi: error: FIELD:" prefix, every fragment.
 void check_bad_input(const CommandResult& r, const std::string& field, const std::vector<std::string>& fragments) {

@@ -1,0 +1,81 @@
+#include "study_command.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
+
+#include "config.hpp"
+#include "plugin_setup.hpp"
+#include "study_report.hpp"
+#include "study_runner.hpp"
+
+namespace tsi::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string shell_quoted(const std::string& s) { return "'" + s + "'"; }
+
+}  // namespace
+
+std::string plot_script_path() {
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const auto installed = exe.parent_path().parent_path() / "share" / "tsi" / "plot_study.py";
+    if (std::filesystem::exists(installed)) return installed.string();
+  }
+  return TSI_SOURCE_SCRIPT_DIR "/plot_study.py";
+}
+
+int study_command(PluginLoader& loader, Registry& registry, const std::string& study_path, std::string out_dir,
+                  int jobs, const std::vector<std::string>& overrides, bool plots) {
+  Json spec = load_config_file(study_path);
+  if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
+    load_config_plugins(loader, spec["base"]["plugins"], study_path);
+  const Study study = expand_study(spec, registry, overrides);
+  if (out_dir.empty()) out_dir = "out/" + std::filesystem::path(study_path).stem().string();
+  if (jobs <= 0) jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+
+  const bool tty = isatty(fileno(stderr));
+  const auto start = Clock::now();
+  auto progress = [&](size_t done, size_t total) {
+    if (!tty) return;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    const double estimate = done ? elapsed * static_cast<double>(total - done) / static_cast<double>(done) : 0.0;
+    fmt::print(stderr, "\r  {}/{} done, {:.1f} s elapsed, about {:.0f} s to go   ", done, total, elapsed, estimate);
+  };
+  if (tty) fmt::print(stderr, "  {} runs on {} threads\n", study.runs.size(), jobs);
+  const auto outcomes = run_study(study, registry, jobs, progress);
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  if (tty) fmt::print(stderr, "\r{:70}\r", "");
+
+  const Json rows = study_rows(study, outcomes);
+  write_study_files(out_dir, study, outcomes, rows, wall, jobs);
+  fmt::print("{}", study_text(study, rows));
+  fmt::print("  wall time {:.2f} s on {} threads\n", wall, jobs);
+  fmt::print("  written: {0}/table.csv, {0}/study.json, {0}/runs/\n", out_dir);
+
+  const std::string script = plot_script_path();
+  std::fflush(stdout);  // the script prints too: keep the order
+  if (plots) {
+    const int have_matplotlib = std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1");
+    if (have_matplotlib == 0 && std::filesystem::exists(script)) {
+      const int rc = std::system(("/usr/bin/python3 " + shell_quoted(script) + " " + shell_quoted(out_dir)).c_str());
+      if (rc != 0) fmt::print("  plotting failed; rerun: python3 {} {}\n", script, out_dir);
+    } else {
+      fmt::print("  no plots: install python3-matplotlib, then run: python3 {} {}\n", script, out_dir);
+    }
+  }
+  // A blow-up is a measured outcome (FD and ME blow up on long runs); an error is not.
+  for (const auto& row : rows)
+    if (row["status"] == "failed") return 1;
+  return 0;
+}
+
+}  // namespace tsi::app

@@ -1,0 +1,347 @@
+#include "study_report.hpp"
+
+#include <fmt/format.h>
+#include <sys/utsname.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "run_files.hpp"
+#include "tsi/convergence.hpp"
+#include "tsi/output.hpp"
+#include "tsi/version.hpp"
+
+namespace tsi::app {
+namespace {
+
+// The columns of table.csv, before the varied paths that are not among them.
+const std::vector<std::string> columns = {
+    "id", "label", "model", "scheme", "reformulation", "eps", "h", "t_end", "n_tau", "error", "order",
+    "err_H", "err_I", "err_m", "drift_H", "drift_I", "drift_m", "sweeps_mean", "rhs_evals",
+    "wall_seconds", "t_reached", "status"};
+const std::set<std::string> covered = {"model.name", "scheme.name", "reformulation.name", "model.eps",
+                                       "time.h", "time.t_end", "reformulation.n_tau"};
+
+Json number_or_null(const Json& j, const Json::json_pointer& p) { return j.contains(p) ? j.at(p) : Json(); }
+
+// Everything that makes a series: a run's row without its h and the measured values.
+std::string series_key(const Json& row, bool without_eps) {
+  Json key = {row["label"], row["model"], row["scheme"], row["reformulation"], row["t_end"], row["n_tau"],
+              row["varied"]};
+  if (!without_eps) key.push_back(row["eps"]);
+  return key.dump();
+}
+
+std::string fraction(double x) {
+  const double inverse = 1.0 / x;
+  if (x < 1.0 && std::abs(inverse - std::round(inverse)) < 1e-9 * inverse) return fmt::format("1/{:.0f}", inverse);
+  return fmt::format("{:g}", x);
+}
+
+std::string cell(const Json& v, const char* format = "{:.3e}") {
+  return v.is_number() ? fmt::format(fmt::runtime(format), v.get<double>()) : std::string("-");
+}
+
+std::string csv_field(const Json& v) {
+  if (v.is_null()) return "";
+  if (v.is_string()) {
+    std::string s = v.get<std::string>();
+    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    std::string quoted = "\"";
+    for (char c : s) quoted += (c == '"') ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
+    return quoted + "\"";
+  }
+  if (v.is_number_float()) return fmt::format("{:.10g}", v.get<double>());
+  return v.dump();
+}
+
+Json machine_json() {
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  struct utsname u {};
+  uname(&u);
+  std::string cpu;
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; std::getline(cpuinfo, line);)
+    if (line.rfind("model name", 0) == 0) {
+      cpu = line.substr(line.find(':') + 2);
+      break;
+    }
+  return {{"hostname", host}, {"cpu", cpu}, {"cores", std::thread::hardware_concurrency()},
+          {"os", std::string(u.sysname) + " " + u.release}};
+}
+
+}  // namespace
+
+double drift_slope(const std::string& csv, const std::string& column, double t_from) {
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  for (std::istringstream h(line); std::getline(h, line, ',');) header.push_back(line);
+  const auto it = std::find(header.begin(), header.end(), column);
+  if (it == header.end()) return std::nan("");
+  const size_t col = static_cast<size_t>(it - header.begin());
+  double n = 0, st = 0, sy = 0, stt = 0, sty = 0;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    for (std::istringstream fields(line); std::getline(fields, line, ',');) v.push_back(std::stod(line));
+    if (v.size() <= col || v[0] < t_from) continue;
+    n += 1, st += v[0], sy += v[col], stt += v[0] * v[0], sty += v[0] * v[col];
+  }
+  const double denominator = n * stt - st * st;
+  return n >= 2 && denominator > 0 ? (n * sty - st * sy) / denominator : std::nan("");
+}
+
+Json study_rows(const Study& study, const std::vector<RunOutcome>& outcomes) {
+  Json rows = Json::array();
+  for (size_t i = 0; i < study.runs.size(); ++i) {
+    const StudyRun& run = study.runs[i];
+    const Json& c = run.config;
+    const Json& r = outcomes[i].result;
+    const double t_end = c["time"]["t_end"];
+    Json row = {{"id", run.id},
+                {"label", run.label},
+                {"model", c["model"]["name"]},
+                {"scheme", c["scheme"]["name"]},
+                {"reformulation", c["reformulation"]["name"]},
+                {"eps", c["model"]["eps"]},
+                {"h", c["time"]["h"]},
+                {"t_end", t_end},
+                {"n_tau", c["reformulation"].value("n_tau", Json())},
+                {"error", number_or_null(r, "/error/relative"_json_pointer)},
+                {"order", nullptr},
+                {"err_H", number_or_null(r, "/invariants/H/max_rel_error"_json_pointer)},
+                {"err_I", number_or_null(r, "/invariants/I/max_rel_error"_json_pointer)},
+                {"err_m", number_or_null(r, "/invariants/m/max_rel_error"_json_pointer)},
+                {"sweeps_mean", number_or_null(r, "/solver/iterations_mean"_json_pointer)},
+                {"rhs_evals", number_or_null(r, "/rhs_evaluations"_json_pointer)},
+                {"wall_seconds", number_or_null(r, "/wall_seconds"_json_pointer)},
+                {"t_reached", number_or_null(r, "/t_reached"_json_pointer)},
+                {"status", r.value("status", std::string("failed"))},
+                {"message", outcomes[i].message}};
+    for (const char* x : {"H", "I", "m"}) {
+      const double slope = drift_slope(outcomes[i].csv, std::string("err_") + x, 0.1 * t_end);
+      row[std::string("drift_") + x] = std::isfinite(slope) ? Json(slope) : Json();
+    }
+    Json varied = Json::object();
+    for (const auto& [path, value] : run.assignments.items())
+      if (!covered.count(path)) varied[path] = value;
+    row["varied"] = varied;
+    rows.push_back(row);
+  }
+  // Observed order against the next larger h in the same series.
+  std::map<std::string, std::vector<size_t>> series;
+  for (size_t i = 0; i < rows.size(); ++i) series[series_key(rows[i], false)].push_back(i);
+  for (auto& [key, members] : series) {
+    std::sort(members.begin(), members.end(),
+              [&](size_t a, size_t b) { return rows[a]["h"].get<double>() > rows[b]["h"].get<double>(); });
+    for (size_t k = 1; k < members.size(); ++k) {
+      const Json &coarse = rows[members[k - 1]], &fine = rows[members[k]];
+      if (!coarse["error"].is_number() || !fine["error"].is_number()) continue;
+      const double e0 = coarse["error"], e1 = fine["error"], h0 = coarse["h"], h1 = fine["h"];
+      if (e0 > 0 && e1 > 0 && h0 != h1) rows[members[k]]["order"] = std::log(e0 / e1) / std::log(h0 / h1);
+    }
+  }
+  return rows;
+}
+
+Json convergence_summary(const Json& rows) {
+  std::map<std::string, std::vector<const Json*>> series;
+  for (const auto& row : rows)
+    if (row["error"].is_number() && row["error"].get<double>() > 0) series[series_key(row, false)].push_back(&row);
+  Json out = {{"series", Json::array()}, {"uniform", Json::array()}};
+  for (auto& [key, members] : series) {
+    std::sort(members.begin(), members.end(), [](const Json* a, const Json* b) { return (*a)["h"] > (*b)["h"]; });
+    std::vector<double> h, e;
+    for (const Json* m : members) h.push_back((*m)["h"]), e.push_back((*m)["error"]);
+    Json s = {{"label", (*members[0])["label"]}, {"scheme", (*members[0])["scheme"]},
+              {"model", (*members[0])["model"]}, {"eps", (*members[0])["eps"]},
+              {"varied", (*members[0])["varied"]}, {"h", h}, {"error", e}};
+    s["successive_orders"] = h.size() >= 2 ? Json(successive_orders(h, e)) : Json::array();
+    s["least_squares_order"] = h.size() >= 2 ? Json(least_squares_order(h, e)) : Json();
+    out["series"].push_back(s);
+  }
+  // Uniform error: at each h, the largest error over eps, per series without eps.
+  std::map<std::string, std::map<double, double>> uniform;
+  std::map<std::string, const Json*> first;
+  for (const auto& row : rows) {
+    if (!row["error"].is_number()) continue;
+    const std::string key = series_key(row, true);
+    double& worst = uniform[key][row["h"].get<double>()];
+    worst = std::max(worst, row["error"].get<double>());
+    first.emplace(key, &row);
+  }
+  for (const auto& [key, by_h] : uniform) {
+    Json u = {{"label", (*first[key])["label"]}, {"scheme", (*first[key])["scheme"]},
+              {"model", (*first[key])["model"]}, {"varied", (*first[key])["varied"]},
+              {"h", Json::array()}, {"max_error_over_eps", Json::array()}};
+    for (auto it = by_h.rbegin(); it != by_h.rend(); ++it) {
+      u["h"].push_back(it->first);
+      u["max_error_over_eps"].push_back(it->second);
+    }
+    out["uniform"].push_back(u);
+  }
+  return out;
+}
+
+Json work_at_error(const Json& rows, const std::vector<double>& targets) {
+  std::map<std::pair<std::string, double>, std::vector<std::pair<double, double>>> series;  // (error, wall)
+  std::vector<std::pair<std::string, double>> order;
+  for (const auto& row : rows) {
+    if (!row["error"].is_number() || !row["wall_seconds"].is_number() || row["error"].get<double>() <= 0) continue;
+    const std::string name = row["label"].get<std::string>().empty() ? row["scheme"].get<std::string>()
+                                                                     : row["label"].get<std::string>();
+    const auto key = std::make_pair(name, row["eps"].get<double>());
+    if (!series.count(key)) order.push_back(key);
+    series[key].emplace_back(row["error"].get<double>(), std::max(row["wall_seconds"].get<double>(), 1e-9));
+  }
+  Json out = Json::array();
+  for (const auto& key : order) {
+    auto points = series[key];
+    std::sort(points.begin(), points.end());
+    Json seconds = Json::array();
+    for (double target : targets) {
+      Json t;  // null when no two runs bracket the target
+      for (size_t i = 0; i + 1 < points.size(); ++i) {
+        const auto [e0, w0] = points[i];
+        const auto [e1, w1] = points[i + 1];
+        if (e0 <= target && target <= e1) {
+          const double x = std::log(target / e0) / std::log(e1 / e0);
+          t = std::exp(std::log(w0) + x * std::log(w1 / w0));
+          break;
+        }
+      }
+      seconds.push_back(t);
+    }
+    out.push_back({{"name", key.first}, {"eps", key.second}, {"targets", targets}, {"seconds", seconds}});
+  }
+  return out;
+}
+
+void write_study_files(const std::string& dir, const Study& study, const std::vector<RunOutcome>& outcomes,
+                       const Json& rows, double wall_seconds, int jobs) {
+  for (size_t i = 0; i < study.runs.size(); ++i) write_run_files(dir + "/runs/" + study.runs[i].id, outcomes[i]);
+  std::vector<std::string> extra;
+  for (const auto& path : study.varied)
+    if (!covered.count(path)) extra.push_back(path);
+  std::string csv;
+  for (const auto& c : columns) csv += c + ",";
+  for (const auto& p : extra) csv += p + ",";
+  csv += "message\n";
+  for (const auto& row : rows) {
+    for (const auto& c : columns) csv += csv_field(row[c]) + ",";
+    for (const auto& p : extra) csv += csv_field(row["varied"].value(p, Json())) + ",";
+    csv += csv_field(row["message"]) + "\n";
+  }
+  write_file_atomically(dir + "/table.csv", csv);
+  Json out = {{"tsi_version", version_string}, {"study", study.spec}, {"kind", study.kind},
+              {"title", study.title}, {"machine", machine_json()}, {"jobs", jobs},
+              {"wall_seconds", wall_seconds}, {"table", rows}};
+  if (study.kind == "convergence") out["convergence"] = convergence_summary(rows);
+  if (study.kind == "work-precision") out["work_at_error"] = work_at_error(rows, {1e-4, 1e-6});
+  write_file_atomically(dir + "/study.json", out.dump(2) + "\n");
+}
+
+std::string study_text(const Study& study, const Json& rows) {
+  std::string s = study.title.empty() ? "" : study.title + "\n";
+  size_t failed = 0;
+  for (const auto& row : rows)
+    if (row["status"] != "completed") {
+      ++failed;
+      s += fmt::format("  {} {} ({}, eps = {:g}, h = {:g}): {}\n", row["status"].get<std::string>(),
+                       row["id"].get<std::string>(), row["scheme"].get<std::string>(), row["eps"].get<double>(),
+                       row["h"].get<double>(), row["message"].get<std::string>());
+    }
+  if (study.kind == "convergence") {
+    const Json summary = convergence_summary(rows);
+    std::map<std::string, std::vector<const Json*>> groups;  // one table per series without eps
+    std::vector<std::string> order;
+    for (const auto& row : rows) {
+      const std::string key = series_key(row, true);
+      if (!groups.count(key)) order.push_back(key);
+      groups[key].push_back(&row);
+    }
+    for (const auto& key : order) {
+      const auto& members = groups[key];
+      const Json& first = *members[0];
+      std::set<double, std::greater<>> epss, hs;
+      std::map<std::pair<double, double>, const Json*> at;
+      for (const Json* m : members) {
+        epss.insert((*m)["eps"].get<double>()), hs.insert((*m)["h"].get<double>());
+        at[{(*m)["eps"].get<double>(), (*m)["h"].get<double>()}] = m;
+      }
+      std::string name = first["label"].get<std::string>().empty() ? first["scheme"].get<std::string>()
+                                                                   : first["label"].get<std::string>();
+      if (!first["varied"].empty()) name = fmt::format("{} {}", name, first["varied"].dump());
+      s += fmt::format("\n{} on {}: relative error at t = {:g} (observed order)\n", name,
+                       first["model"].get<std::string>(), first["t_end"].get<double>());
+      s += fmt::format("  {:>8}", "h");
+      for (double e : epss) s += fmt::format("{:>21}", "eps=" + fraction(e));
+      s += fmt::format("{:>14}\n", "max over eps");
+      for (double h : hs) {
+        s += fmt::format("  {:>8}", fraction(h));
+        double worst = 0;
+        for (double e : epss) {
+          const auto it = at.find({e, h});
+          const Json* r = it == at.end() ? nullptr : it->second;
+          std::string c = r ? cell((*r)["error"]) : "";
+          if (r && (*r)["order"].is_number()) c += fmt::format(" ({:.2f})", (*r)["order"].get<double>());
+          if (r && (*r)["error"].is_number()) worst = std::max(worst, (*r)["error"].get<double>());
+          s += fmt::format("{:>21}", c);
+        }
+        s += fmt::format("{:>14.3e}\n", worst);
+      }
+      s += fmt::format("  {:>8}", "LS order");
+      for (double e : epss) {
+        std::string c = "-";
+        for (const auto& series : summary["series"])
+          if (series["eps"] == e && series["scheme"] == first["scheme"] && series["label"] == first["label"] &&
+              series["varied"] == first["varied"] && series["model"] == first["model"] &&
+              series["least_squares_order"].is_number())
+            c = fmt::format("{:.2f}", series["least_squares_order"].get<double>());
+        s += fmt::format("{:>21}", c);
+      }
+      s += "\n";
+    }
+  } else {
+    const bool conservation = study.kind == "conservation";
+    s += conservation ? fmt::format("\n  {:<24}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}{:>11}  {}\n", "scheme", "eps", "h",
+                                    "max err_H", "drift_H", "max err_I", "max err_m", "t reached", "status")
+                      : fmt::format("\n  {:<24}{:>10}{:>9}{:>10}{:>11}{:>12}{:>10}\n", "scheme", "eps", "h", "tol",
+                                    "error", "rhs evals", "wall s");
+    for (const auto& row : rows) {
+      std::string name = row["label"].get<std::string>().empty() ? row["scheme"].get<std::string>()
+                                                                 : row["label"].get<std::string>();
+      if (conservation) {
+        s += fmt::format("  {:<24}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}{:>11}  {}\n", name,
+                         fraction(row["eps"]), fraction(row["h"]), cell(row["err_H"]), cell(row["drift_H"], "{:.2e}"),
+                         cell(row["err_I"]), cell(row["err_m"]), cell(row["t_reached"], "{:g}"),
+                         row["status"].get<std::string>());
+      } else {
+        const Json tol = row["varied"].value("scheme.tol", Json());
+        s += fmt::format("  {:<24}{:>10}{:>9}{:>10}{:>11}{:>12}{:>10}\n", name, fraction(row["eps"]),
+                         fraction(row["h"]), tol.is_number() ? fmt::format("{:.0e}", tol.get<double>()) : "",
+                         cell(row["error"]), row["rhs_evals"].is_number() ? row["rhs_evals"].dump() : "-",
+                         cell(row["wall_seconds"], "{:.4f}"));
+      }
+    }
+  }
+  if (study.kind == "work-precision") {
+    const Json work = work_at_error(rows, {1e-4, 1e-6});
+    s += "\n  wall time to reach a relative error (log-log interpolation between runs):\n";
+    s += fmt::format("  {:<24}{:>12}{:>14}{:>14}\n", "scheme", "eps", "error 1e-4", "error 1e-6");
+    for (const auto& w : work)
+      s += fmt::format("  {:<24}{:>12}{:>14}{:>14}\n", w["name"].get<std::string>(), fraction(w["eps"]),
+                       cell(w["seconds"][0], "{:.2e} s"), cell(w["seconds"][1], "{:.2e} s"));
+  }
+  s += fmt::format("\n  {} runs, {} completed, {} not\n", rows.size(), rows.size() - failed, failed);
+  return s;
+}
+
+}  // namespace tsi::app

@@ -1,0 +1,33 @@
+#pragma once
+#include <string>
+#include <vector>
+
+#include "run.hpp"
+#include "study_spec.hpp"
+
+namespace tsi::app {
+
+/// One row per run (the columns of table.csv), with derived quantities: the observed order
+/// against the next larger h of the same series, and the drift slopes of err_H, err_I,
+/// err_m (least squares over the last 90% of the run).
+Json study_rows(const Study& study, const std::vector<RunOutcome>& outcomes);
+
+/// Per-series convergence data: h, errors, successive and least-squares orders, and the
+/// uniform error (max over eps) per scheme and h.
+Json convergence_summary(const Json& rows);
+
+/// Wall time to reach each target error per (scheme or label, eps) series, by log-log
+/// interpolation between the two runs that bracket it (null when none do).
+Json work_at_error(const Json& rows, const std::vector<double>& targets);
+
+/// Least-squares slope of column `column` against t over t >= t_from, from invariants.csv.
+double drift_slope(const std::string& csv, const std::string& column, double t_from);
+
+/// Writes DIR/table.csv, DIR/study.json and DIR/runs/<id>/{result.json, invariants.csv}.
+void write_study_files(const std::string& dir, const Study& study, const std::vector<RunOutcome>& outcomes,
+                       const Json& rows, double wall_seconds, int jobs);
+
+/// The tables printed on the terminal, by kind.
+std::string study_text(const Study& study, const Json& rows);
+
+}  // namespace tsi::app

@@ -1,0 +1,92 @@
+#include "study_runner.hpp"
+
+#include <atomic>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "tsi/version.hpp"
+
+namespace tsi::app {
+namespace {
+
+// Calls work(i) for i in [0, n) on `jobs` threads; work must not throw.
+void parallel_for(size_t n, int jobs, const std::function<void(size_t)>& work) {
+  std::atomic<size_t> next{0};
+  auto worker = [&] {
+    for (size_t i; (i = next++) < n;) work(i);
+  };
+  std::vector<std::thread> threads;
+  const size_t count = std::min<size_t>(n, static_cast<size_t>(std::max(1, jobs)));
+  for (size_t t = 1; t < count; ++t) threads.emplace_back(worker);
+  worker();
+  for (auto& t : threads) t.join();
+}
+
+RunOutcome failed_outcome(const StudyRun& run, const std::string& message) {
+  RunOutcome o;
+  o.ok = false;
+  o.message = message;
+  o.result = {{"tsi_version", version_string}, {"config", run.config}, {"status", "failed"},
+              {"message", message}, {"warnings", Json::array()}};
+  return o;
+}
+
+}  // namespace
+
+std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, int jobs,
+                                  const StudyProgressFn& progress) {
+  // Distinct references, each computed once.
+  std::map<std::string, size_t> reference_index;
+  std::vector<const Json*> reference_configs;
+  for (const auto& run : study.runs) {
+    if (!run.config.contains("reference")) continue;
+    if (reference_index.emplace(reference_key(run.config), reference_configs.size()).second)
+      reference_configs.push_back(&run.config);
+  }
+  const size_t total = reference_configs.size() + study.runs.size();
+  std::atomic<size_t> done{0};
+  std::mutex progress_mutex;
+  auto tick = [&] {
+    const size_t d = ++done;
+    if (progress) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      progress(d, total);
+    }
+  };
+
+  std::vector<ReferenceSolution> references(reference_configs.size());
+  std::vector<std::string> reference_errors(reference_configs.size());
+  parallel_for(reference_configs.size(), jobs, [&](size_t i) {
+    try {
+      references[i] = compute_reference(*reference_configs[i], registry);
+    } catch (const std::exception& e) {
+      reference_errors[i] = e.what();
+    }
+    tick();
+  });
+
+  std::vector<RunOutcome> outcomes(study.runs.size());
+  parallel_for(study.runs.size(), jobs, [&](size_t i) {
+    const StudyRun& run = study.runs[i];
+    const ReferenceSolution* reference = nullptr;
+    if (run.config.contains("reference")) {
+      const size_t r = reference_index.at(reference_key(run.config));
+      if (!reference_errors[r].empty()) {
+        outcomes[i] = failed_outcome(run, "the reference solution failed: " + reference_errors[r]);
+        tick();
+        return;
+      }
+      reference = &references[r];
+    }
+    try {
+      outcomes[i] = execute_run(run.config, registry, {}, reference);
+    } catch (const std::exception& e) {
+      outcomes[i] = failed_outcome(run, e.what());
+    }
+    tick();
+  });
+  return outcomes;
+}
+
+}  // namespace tsi::app

@@ -1,0 +1,107 @@
+#include "study_spec.hpp"
+
+#include <fmt/format.h>
+
+#include "config.hpp"
+#include "tsi/error.hpp"
+
+namespace tsi::app {
+namespace {
+
+const std::vector<std::string> kinds = {"convergence", "conservation", "work-precision"};
+
+// A "vary" object as ordered (path, values) pairs; each list must be non-empty.
+std::vector<std::pair<std::string, Json>> vary_lists(const Json& vary, const std::string& where) {
+  if (!vary.is_object()) throw ConfigError(where, "got " + vary.dump() + ", expected an object of path: [values]");
+  std::vector<std::pair<std::string, Json>> out;
+  for (const auto& [path, values] : vary.items()) {
+    if (!values.is_array() || values.empty())
+      throw ConfigError(where + "." + path, "got " + values.dump() + ", expected a non-empty list of values");
+    out.emplace_back(path, values);
+  }
+  return out;
+}
+
+std::string describe_assignments(const Json& assignments) {
+  std::string s;
+  for (const auto& [path, value] : assignments.items()) s += (s.empty() ? "" : ", ") + path + "=" + value.dump();
+  return s;
+}
+
+}  // namespace
+
+Study expand_study(const Json& spec, const Registry& registry, const std::vector<std::string>& overrides) {
+  if (!spec.is_object()) throw ConfigError("study", "got " + spec.dump() + ", expected a JSON object");
+  for (const auto& [key, value] : spec.items())
+    if (key != "kind" && key != "title" && key != "base" && key != "vary" && key != "cases")
+      throw ConfigError(key, "unknown study key; valid keys are: base, cases, kind, title, vary");
+  Study study;
+  study.spec = spec;
+  study.kind = spec.value("kind", std::string("convergence"));
+  if (std::find(kinds.begin(), kinds.end(), study.kind) == kinds.end())
+    throw ConfigError("kind", "got \"" + study.kind + "\", expected one of: convergence, conservation, work-precision");
+  study.title = spec.value("title", std::string());
+  if (!spec.contains("base") || !spec["base"].is_object())
+    throw ConfigError("base", "missing or not an object; it is the run config every run starts from");
+  Json base = spec["base"];
+  for (const auto& assignment : overrides) apply_override(base, assignment);
+  study.spec["base"] = base;
+
+  const auto common = vary_lists(spec.value("vary", Json::object()), "vary");
+  Json cases = spec.value("cases", Json::array({Json::object()}));
+  if (!cases.is_array() || cases.empty()) throw ConfigError("cases", "expected a non-empty list of cases");
+
+  for (size_t c = 0; c < cases.size(); ++c) {
+    const Json& one = cases[c];
+    const std::string where = fmt::format("cases[{}]", c);
+    if (!one.is_object()) throw ConfigError(where, "got " + one.dump() + ", expected an object");
+    Json config = base;
+    const Json set = one.value("set", Json::object());  // a named copy: items() must not outlive it
+    if (!set.is_object()) throw ConfigError(where + ".set", "got " + set.dump() + ", expected an object of path: value");
+    for (const auto& [path, value] : set.items())
+      assign_path(config, path, value, where + ".set." + path);
+    auto lists = common;
+    for (auto& [path, values] : vary_lists(one.value("vary", Json::object()), where + ".vary")) {
+      auto it = std::find_if(lists.begin(), lists.end(), [&](const auto& p) { return p.first == path; });
+      if (it != lists.end()) it->second = values; else lists.emplace_back(path, values);
+    }
+    for (const auto& [path, values] : lists)
+      if (std::find(study.varied.begin(), study.varied.end(), path) == study.varied.end())
+        study.varied.push_back(path);
+
+    // The cartesian product, last path fastest (an odometer over the lists).
+    std::vector<size_t> index(lists.size(), 0);
+    for (bool done = false; !done;) {
+      StudyRun run;
+      run.id = fmt::format("r{:04d}", study.runs.size() + 1);
+      run.label = one.value("label", std::string());
+      run.assignments = Json::object();
+      Json raw = config;
+      for (size_t k = 0; k < lists.size(); ++k) {
+        const Json& value = lists[k].second[index[k]];
+        run.assignments[lists[k].first] = value;
+        assign_path(raw, lists[k].first, value, "vary." + lists[k].first);
+      }
+      try {
+        run.config = resolve_run_config(raw, registry);
+      } catch (const ConfigError& e) {
+        const std::string what = e.what();
+        const std::string message = e.field().empty() ? what : what.substr(e.field().size() + 2);
+        throw ConfigError(e.field(), fmt::format("{} (run {}: {})", message, run.id,
+                                                 describe_assignments(run.assignments)));
+      }
+      study.runs.push_back(std::move(run));
+      done = true;
+      for (size_t k = lists.size(); k-- > 0;) {
+        if (++index[k] < lists[k].second.size()) {
+          done = false;
+          break;
+        }
+        index[k] = 0;
+      }
+    }
+  }
+  return study;
+}
+
+}  // namespace tsi::app

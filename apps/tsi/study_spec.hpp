@@ -1,0 +1,36 @@
+#pragma once
+#include <string>
+#include <vector>
+
+#include "tsi/params.hpp"
+#include "tsi/registry.hpp"
+
+namespace tsi::app {
+
+/// One run of a study: the values it varies and its fully resolved config.
+struct StudyRun {
+  std::string id;      ///< r0001, r0002, ... in expansion order
+  std::string label;   ///< the case's label ("" without cases)
+  Json assignments;    ///< path -> value: what this run sets beyond the base
+  Json config;         ///< resolved, as `tsi run` would use it
+};
+
+/// A study: a base run config, lists of values for config paths run as their cartesian
+/// product, optionally per case (a case sets paths of its own and may vary more):
+///   {"kind": "convergence" | "conservation" | "work-precision", "title": "...",
+///    "base": {run config}, "vary": {"path": [values]},
+///    "cases": [{"label": "...", "set": {"path": value}, "vary": {...}}]}
+struct Study {
+  std::string kind;
+  std::string title;
+  Json spec;  ///< the study file as given (after --set on its base)
+  std::vector<StudyRun> runs;
+  std::vector<std::string> varied;  ///< every varied path, in first-seen order
+};
+
+/// Validates and expands a study; every run is resolved before any runs, so a bad path or
+/// value is reported (naming the run and the path) before work starts. `overrides` are
+/// --set assignments applied to the base.
+Study expand_study(const Json& spec, const Registry& registry, const std::vector<std::string>& overrides);
+
+}  // namespace tsi::app

@@ -1,0 +1,143 @@
+#!/usr/bin/python3
+"""Plots a tsi study from its files only (table.csv, study.json, runs/*/invariants.csv), so
+the figures can be restyled without rerunning anything:
+
+    python3 scripts/plot_study.py OUT_DIR
+
+convergence:    convergence.png     error against h, one panel per scheme, one curve per eps
+conservation:   conservation.png    err_H, err_I, err_m against t, one row per scheme
+work-precision: work_precision.png  error against wall time and against evaluations
+"""
+import csv
+import json
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def fraction(x):
+    inv = 1.0 / x
+    return f"1/{round(inv)}" if x < 1 and abs(inv - round(inv)) < 1e-9 * inv else f"{x:g}"
+
+
+def number(s):
+    try:
+        return float(s)
+    except (TypeError, ValueError):
+        return None
+
+
+def series_name(row):
+    return row["label"] or row["scheme"]
+
+
+def panels(n, width=6.0, height=4.4):
+    cols = min(2, n)
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(width * cols, height * rows), squeeze=False)
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+    return fig, list(axes.flat[:n])
+
+
+def plot_convergence(rows, title, out):
+    rows = [r for r in rows if number(r["error"])]
+    names = list(dict.fromkeys(series_name(r) for r in rows))
+    fig, axes = panels(len(names))
+    for ax, name in zip(axes, names):
+        mine = [r for r in rows if series_name(r) == name]
+        for eps in sorted({number(r["eps"]) for r in mine}, reverse=True):
+            pts = sorted((number(r["h"]), number(r["error"])) for r in mine if number(r["eps"]) == eps)
+            ax.loglog(*zip(*pts), "o-", label=f"eps = {fraction(eps)}")
+        hs = sorted({number(r["h"]) for r in mine})
+        top = max(number(r["error"]) for r in mine if number(r["h"]) == hs[-1])
+        ax.loglog(hs, [1.5 * top * (h / hs[-1]) ** 2 for h in hs], "k--", label="slope 2")
+        ax.set(xlabel="time step h", ylabel="relative error at t_end", title=f"{name} ({mine[0]['model']})")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "convergence.png"), dpi=110)
+
+
+def read_invariants(path):
+    with open(path) as f:
+        data = list(csv.DictReader(f))
+    return {k: [number(d[k]) for d in data] for k in ("t", "err_H", "err_I", "err_m")}
+
+
+def plot_conservation(rows, title, out):
+    names = list(dict.fromkeys(series_name(r) for r in rows))
+    fig, axes = plt.subplots(len(names), 3, figsize=(15, 3.2 * len(names)), squeeze=False)
+    for i, name in enumerate(names):
+        for r in (r for r in rows if series_name(r) == name):
+            path = os.path.join(out, "runs", r["id"], "invariants.csv")
+            if not os.path.exists(path):
+                continue
+            inv = read_invariants(path)
+            label = f"eps = {fraction(number(r['eps']))}, h = {fraction(number(r['h']))}"
+            if r["status"] != "completed":
+                label += f" ({r['status']} at t = {number(r['t_reached']) or 0:g})"
+            for j, key in enumerate(("err_H", "err_I", "err_m")):
+                pts = [(t, e) for t, e in zip(inv["t"], inv[key]) if t > 0 and e and e > 0]
+                if pts:
+                    axes[i][j].semilogy(*zip(*pts), lw=0.8, label=label)
+        for j, key in enumerate(("err_H", "err_I", "err_m")):
+            ax = axes[i][j]
+            ax.set(xlabel="t", ylabel=key, title=f"{name}: {key}")
+            ax.grid(True, which="both", alpha=0.3)
+            if ax.lines:
+                ax.legend(fontsize=7)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "conservation.png"), dpi=100)
+
+
+def plot_work_precision(rows, title, out):
+    rows = [r for r in rows if number(r["error"]) and number(r["wall_seconds"])]
+    fig, axes = plt.subplots(1, 2, figsize=(14, 5.2))
+    eps_values = sorted({number(r["eps"]) for r in rows}, reverse=True)
+    colors = {e: f"C{i}" for i, e in enumerate(eps_values)}
+    styles = ["o-", "s--", "^:", "v-.", "D-", "P--"]
+    for k, name in enumerate(dict.fromkeys(series_name(r) for r in rows)):
+        for eps in eps_values:
+            mine = [r for r in rows if series_name(r) == name and number(r["eps"]) == eps]
+            if not mine:
+                continue
+            for ax, x in zip(axes, ("wall_seconds", "rhs_evals")):
+                pts = sorted((number(r[x]), number(r["error"])) for r in mine)
+                ax.loglog(*zip(*pts), styles[k % len(styles)], color=colors[eps],
+                          label=f"{name}, eps = {fraction(eps)}")
+    axes[0].set(xlabel="wall time [s]", ylabel="relative error at t_end", title="error against time")
+    axes[1].set(xlabel="nonlinearity evaluations (two-scale: one covers all tau points)",
+                ylabel="relative error at t_end", title="error against evaluations")
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+    axes[1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "work_precision.png"), dpi=110)
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    out = sys.argv[1]
+    with open(os.path.join(out, "study.json")) as f:
+        study = json.load(f)
+    with open(os.path.join(out, "table.csv")) as f:
+        rows = list(csv.DictReader(f))
+    kind, title = study["kind"], study.get("title", "")
+    {"convergence": plot_convergence, "conservation": plot_conservation,
+     "work-precision": plot_work_precision}[kind](rows, title, out)
+    name = {"convergence": "convergence", "conservation": "conservation", "work-precision": "work_precision"}[kind]
+    print(f"  plot: {os.path.join(out, name + '.png')}")
+
+
+if __name__ == "__main__":
+    main()

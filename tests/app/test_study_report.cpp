@@ -1,0 +1,71 @@
+// Study tables on synthetic data with known answers: observed orders, drift slopes, and the
+// interpolated work to reach an error.
+#include <doctest/doctest.h>
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "study_report.hpp"
+#include "tsi/convergence.hpp"
+
+namespace {
+
+tsi::Json row(const std::string& id, double eps, double h, double error) {
+  return {{"id", id},        {"label", ""},       {"model", "m"},     {"scheme", "s"},
+          {"reformulation", "two-scale"}, {"eps", eps}, {"h", h}, {"t_end", 1.0},
+          {"n_tau", 64},     {"error", error},    {"varied", tsi::Json::object()}, {"wall_seconds", h},
+          {"status", "completed"}, {"message", ""}};
+}
+
+}  // namespace
+
+TEST_CASE("order estimation recovers the order of synthetic power laws") {
+  const std::vector<double> h = {0.5, 0.25, 0.125, 0.0625};
+  for (double p : {1.0, 2.0, 4.0}) {
+    std::vector<double> e;
+    for (double x : h) e.push_back(3.0 * std::pow(x, p));
+    for (double o : tsi::successive_orders(h, e)) CHECK(o == doctest::Approx(p).epsilon(1e-12));
+    CHECK(tsi::least_squares_order(h, e) == doctest::Approx(p).epsilon(1e-12));
+  }
+  // A perturbed series: the least-squares order lies between the successive ones.
+  const std::vector<double> e = {0.25 * 1.1, 0.0625, 0.015625 * 0.9, 0.00390625};
+  const auto s = tsi::successive_orders(h, e);
+  const double ls = tsi::least_squares_order(h, e);
+  CHECK(ls > *std::min_element(s.begin(), s.end()));
+  CHECK(ls < *std::max_element(s.begin(), s.end()));
+}
+
+TEST_CASE("the convergence summary groups series by eps and takes the max over eps") {
+  tsi::Json rows = tsi::Json::array();
+  int k = 0;
+  for (double eps : {1.0, 0.01})
+    for (double h : {0.5, 0.25, 0.125})
+      rows.push_back(row(fmt::format("r{}", ++k), eps, h, (eps == 1.0 ? 2.0 : 1.0) * h * h));
+  const tsi::Json summary = tsi::app::convergence_summary(rows);
+  REQUIRE(summary["series"].size() == 2);
+  for (const auto& s : summary["series"]) CHECK(s["least_squares_order"].get<double>() == doctest::Approx(2.0));
+  REQUIRE(summary["uniform"].size() == 1);
+  CHECK(summary["uniform"][0]["max_error_over_eps"][0].get<double>() == doctest::Approx(0.5));  // 2 * 0.5^2
+}
+
+TEST_CASE("drift slope is the least-squares slope over the chosen window") {
+  std::string csv = "t,H,I,m,err_H,err_I,err_m,tau_roughness\n";
+  for (int i = 0; i <= 100; ++i) {
+    const double t = i;
+    csv += fmt::format("{},0,0,0,{},5,0,0\n", t, 1e-3 * t + (i % 2 ? 1e-4 : -1e-4));
+  }
+  CHECK(tsi::app::drift_slope(csv, "err_H", 10.0) == doctest::Approx(1e-3).epsilon(1e-2));
+  CHECK(tsi::app::drift_slope(csv, "err_I", 10.0) == doctest::Approx(0.0));
+  CHECK(std::isnan(tsi::app::drift_slope(csv, "nosuch", 10.0)));
+}
+
+TEST_CASE("work to reach an error interpolates between the bracketing runs") {
+  tsi::Json rows = tsi::Json::array();
+  // error = h^2, wall = h: at error 1e-4, h = 1e-2 exactly.
+  for (double h : {0.1, 0.03, 0.003}) rows.push_back(row("r", 1.0, h, h * h));
+  const tsi::Json w = tsi::app::work_at_error(rows, {1e-4, 1e-12});
+  REQUIRE(w.size() == 1);
+  CHECK(w[0]["seconds"][0].get<double>() == doctest::Approx(1e-2).epsilon(1e-9));
+  CHECK(w[0]["seconds"][1].is_null());  // not bracketed
+}

@@ -1,0 +1,94 @@
+// `tsi study` end to end: the files and their schema, shared references, and a failing run
+// that is recorded without stopping the others.
+#include <doctest/doctest.h>
+
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "run_command.hpp"
+
+using namespace tsi::test;
+
+namespace {
+
+Json small_study() {
+  return {{"kind", "convergence"},
+          {"base", {{"model", {{"name", "henon-heiles"}, {"eps", 0.01}}}, {"time", {{"t_end", 1.0}}}, {"reference", Json::object()}}},
+          {"vary", {{"scheme.name", {"se1", "fd"}}, {"model.eps", {1.0, 1.0 / 4096}}, {"time.h", {0.25, 0.125, 0.0625}}}}};
+}
+
+}  // namespace
+
+TEST_CASE("study: table.csv, study.json and one result per run, with orders and uniform errors") {
+  TempDir dir;
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"study", write_config(dir, small_study(), "study.json"), "--out", out, "--jobs", "2", "--no-plots"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  CHECK(contains(r.out, "se1 on henon-heiles"));
+  CHECK(contains(r.out, "LS order"));
+  const auto lines = lines_of(read_text(fs::path(out) / "table.csv"));
+  REQUIRE(lines.size() == 13);  // header and 12 runs
+  const std::vector<std::string> header = csv_fields(lines[0]);
+  for (const char* column : {"model", "scheme", "reformulation", "eps", "h", "t_end", "n_tau", "error", "order", "err_H",
+                             "err_I", "err_m", "sweeps_mean", "rhs_evals", "wall_seconds", "status"})
+    CHECK(std::find(header.begin(), header.end(), column) != header.end());
+  const Json study = read_json(fs::path(out) / "study.json");
+  for (const char* key : {"tsi_version", "study", "machine", "table", "convergence", "wall_seconds"})
+    CHECK(study.contains(key));
+  REQUIRE(study["table"].size() == 12);
+  for (const auto& row : study["table"]) {
+    CHECK(row["status"] == "completed");
+    CHECK(fs::is_regular_file(fs::path(out) / "runs" / row["id"].get<std::string>() / "result.json"));
+    if (row["h"].get<double>() < 0.25) CHECK(row["order"].get<double>() == doctest::Approx(2.0).epsilon(0.1));
+  }
+  CHECK(study["convergence"]["series"].size() == 4);
+  CHECK(study["convergence"]["uniform"].size() == 2);
+  // One reference per eps, shared: every run at the same eps reports the same reference state.
+  std::map<double, std::set<std::string>> references;
+  for (const auto& row : study["table"]) {
+    const Json result = read_json(fs::path(out) / "runs" / row["id"].get<std::string>() / "result.json");
+    references[row["eps"].get<double>()].insert(result["error"]["reference"]["u_final"].dump());
+  }
+  REQUIRE(references.size() == 2);
+  for (const auto& [eps, states] : references) CHECK(states.size() == 1);
+}
+
+TEST_CASE("study: a failing run is recorded with its message and the others complete") {
+  TempDir dir;
+  Json spec = small_study();
+  spec["vary"] = {{"time.h", {0.25, 0.125}}};
+  spec["cases"] = {{{"label", "ok"}},
+                   {{"label", "stops"}, {"set", {{"scheme.max_iter", 1}, {"scheme.on_failure", "stop"}}}}};
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"study", write_config(dir, spec, "study.json"), "--out", out, "--no-plots"});
+  INFO(r.describe());
+  CHECK(r.exit_code == 1);
+  const Json study = read_json(fs::path(out) / "study.json");
+  REQUIRE(study["table"].size() == 4);
+  int completed = 0, failed = 0;
+  for (const auto& row : study["table"]) {
+    if (row["status"] == "completed") ++completed;
+    if (row["status"] == "failed") {
+      ++failed;
+      CHECK(row["label"] == "stops");
+      CHECK(contains(row["message"].get<std::string>(), "max_iter = 1"));
+    }
+  }
+  CHECK(completed == 2);
+  CHECK(failed == 2);
+}
+
+TEST_CASE("study: a bad path is rejected before any run, naming the run and the path") {
+  TempDir dir;
+  Json spec = small_study();
+  spec["vary"]["model.epz"] = {1.0};
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"study", write_config(dir, spec, "study.json"), "--out", out});
+  CHECK(r.exit_code == 2);
+  CHECK(contains(r.err, "model.epz: unknown parameter"));
+  CHECK(contains(r.err, "run r0001"));
+  CHECK_FALSE(fs::exists(fs::path(out) / "table.csv"));
+}
