@@ -2,7 +2,8 @@
 # Installs the Debian packages tsi needs, only those missing (README.md, "Dependencies").
 set -euo pipefail
 packages=(g++ cmake ninja-build pkg-config libeigen3-dev libfftw3-dev nlohmann-json3-dev
-          libfmt-dev libspdlog-dev doctest-dev libcli11-dev libboost-dev python3 python3-matplotlib)
+          libfmt-dev libspdlog-dev doctest-dev libcli11-dev libboost-dev libbenchmark-dev python3
+          python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

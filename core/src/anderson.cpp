@@ -24,7 +24,7 @@ int AndersonSolver::iterate(Vector& x, FixedPointMap g, double& increment) {
     g(x, gx_);
     residual_ = gx_ - x;
     const double scale = max_norm(gx_);
-    increment = residual_.cwiseAbs().maxCoeff() / (scale > 0.0 ? scale : 1.0);
+    increment = max_norm(residual_) / (scale > 0.0 ? scale : 1.0);
     if (increment <= options().tol) {
       x = gx_;
       return k;

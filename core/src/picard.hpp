@@ -14,7 +14,7 @@ class PicardSolver final : public FixedPointSolver {
     for (int k = 1; k <= options().max_iter; ++k) {
       g(x, next_);
       const double scale = max_norm(next_);
-      increment = (next_ - x).cwiseAbs().maxCoeff() / (scale > 0.0 ? scale : 1.0);
+      increment = max_distance(next_, x) / (scale > 0.0 ? scale : 1.0);
       x.swap(next_);
       if (increment <= options().tol) return k;
     }

@@ -6,6 +6,7 @@
 
 #include "tsi/model.hpp"
 #include "tsi/plugin.hpp"
+#include "tsi/rotation_cache.hpp"
 
 namespace {
 
@@ -24,8 +25,9 @@ class HenonHeiles final : public tsi::Model {
 
   // JM couples (q1, p1) only: q1' = p1, p1' = -q1 in tau, a rotation of period 2*pi.
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
+    const auto& table = rotations_.get(taus);
     for (Index j = 0; j < u.cols(); ++j) {
-      const double c = std::cos(taus(j)), s = std::sin(taus(j));
+      const double c = table.cos(j), s = table.sin(j);
       const Complex q1 = u(0, j), p1 = u(2, j);
       u(0, j) = c * q1 + s * p1;
       u(2, j) = -s * q1 + c * p1;
@@ -70,6 +72,9 @@ class HenonHeiles final : public tsi::Model {
   }
 
   Vector initial_value() const override { return Vector::Constant(4, 0.12); }
+
+ private:
+  mutable tsi::RotationCache rotations_;  // the tau grid's cos and sin, computed once
 };
 
 void register_henon_heiles(tsi::Registry& registry) {

@@ -1,5 +1,6 @@
 #pragma once
 #include <Eigen/Dense>
+#include <cmath>
 #include <complex>
 
 namespace tsi {
@@ -17,7 +18,13 @@ using Index = Eigen::Index;
 /// Real inner product <u, v> = Re sum conj(u_i) v_i.
 inline double inner(const Vector& u, const Vector& v) { return u.dot(v).real(); }
 
-/// Largest modulus of the entries (0 for an empty vector).
-inline double max_norm(const Vector& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0; }
+/// Largest modulus of the entries (0 for an empty vector). Squared moduli are compared,
+/// so there is one square root, not one hypot per entry.
+inline double max_norm(const Vector& v) { return v.size() ? std::sqrt(v.cwiseAbs2().maxCoeff()) : 0.0; }
+
+/// max |a_i - b_i| without forming a temporary or a hypot per entry.
+inline double max_distance(const Vector& a, const Vector& b) {
+  return a.size() ? std::sqrt((a - b).cwiseAbs2().maxCoeff()) : 0.0;
+}
 
 }  // namespace tsi

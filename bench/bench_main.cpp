@@ -1,0 +1,135 @@
+// What a two-scale step costs, per model at the paper's sizes, against the FFTs it must do:
+//   nonlinearity/<model>   one evaluation of f_tau over the whole tau grid (one sweep's work)
+//   fft_bound/<model>      the transforms alone that one evaluation needs (back and forth)
+//   step/<model>/<scheme>  one step at h = 1/8, eps = 0.01 (counter: fixed-point sweeps)
+// Models and schemes come from the registry, so a new plugin is benchmarked without edits.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <string>
+
+#include "tsi/fft.hpp"
+#include "tsi/phase.hpp"
+#include "tsi/plugin_loader.hpp"
+#include "tsi/registry.hpp"
+
+namespace {
+
+struct Case {
+  std::string model;
+  tsi::Json model_params;
+  int n_tau;
+};
+
+tsi::Registry& registry() {
+  static tsi::Registry r;
+  static const bool loaded = [] {
+    tsi::register_core(r);
+    tsi::PluginLoader(r).load_directory(TSI_BENCH_PLUGIN_DIR);
+    return true;
+  }();
+  (void)loaded;
+  return r;
+}
+
+std::shared_ptr<const tsi::Model> make_model(const Case& c, double eps) {
+  const auto& e = registry().model(c.model);
+  tsi::Json params = c.model_params;
+  params["eps"] = eps;
+  return e.create(tsi::Params(tsi::resolve_params(e.info.params, params, "model")));
+}
+
+std::unique_ptr<tsi::Reformulation> two_scale(std::shared_ptr<const tsi::Model> model, const Case& c, int order) {
+  const auto& e = registry().reformulation("two-scale");
+  return e.create(std::move(model), tsi::Params(tsi::resolve_params(
+                                        e.info.params, {{"n_tau", c.n_tau}, {"initial_data_order", order}}, "bench")));
+}
+
+void nonlinearity(benchmark::State& state, Case c) {
+  auto model = make_model(c, 0.01);
+  auto problem = two_scale(model, c, 2);
+  const tsi::Vector y = problem->prepare(model->initial_value());
+  tsi::Vector out(y.size());
+  for (auto _ : state) {
+    problem->nonlinear(0.0, y, out);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.counters["unknowns"] = static_cast<double>(y.size());
+}
+
+void fft_bound(benchmark::State& state, Case c) {
+  auto model = make_model(c, 0.01);
+  // The model's own transforms (NLS: in x) happen inside its field; count the tau ones here,
+  // and x ones by a second batch of the same size when the model is a field (complex, dim > 4).
+  tsi::FftBatch tau(c.n_tau, static_cast<int>(model->dim()));
+  const bool field = model->is_complex() && model->dim() > 4;
+  tsi::FftBatch x(static_cast<int>(model->dim()), c.n_tau);
+  tau.data().setRandom();
+  x.data().setRandom();
+  for (auto _ : state) {
+    tau.backward();
+    tau.forward();
+    if (field) {
+      x.backward();
+      x.forward();
+    }
+    benchmark::DoNotOptimize(tau.data().data());
+  }
+}
+
+void step(benchmark::State& state, Case c, std::string scheme) {
+  const auto& s = registry().scheme(scheme);
+  auto model = make_model(c, 0.01);
+  auto problem = two_scale(model, c, std::max(1, s.traits.initial_data_order));
+  tsi::Json params = tsi::resolve_params(s.info.params, tsi::Json::object(), "bench");
+  auto stepper = s.create(tsi::Params(params));
+  const tsi::Vector y0 = problem->prepare(model->initial_value());
+  tsi::Vector y = y0;
+  const double h = 0.125;
+  long n = 0;
+  for (auto _ : state) {
+    stepper->step(*problem, tsi::step_time(n++, h), h, y);
+    if (n == 64) {  // stay on a bounded trajectory
+      state.PauseTiming();
+      y = y0, n = 0;
+      stepper->reset();
+      state.ResumeTiming();
+    }
+  }
+  const auto stats = stepper->stats();
+  state.counters["sweeps"] = stats.solves ? stats.iterations_mean() : 0.0;
+}
+
+std::vector<Case> paper_cases() {
+  std::vector<Case> cases;
+  for (const auto* m : registry().models()) {
+    const std::string& name = m->info.name;
+    if (name == "henon-heiles" || name == "cpd") cases.push_back({name, tsi::Json::object(), 64});
+    if (name == "nls")
+      for (int n_x : {16, 64, 256}) cases.push_back({name, {{"n_x", n_x}}, 256});
+  }
+  return cases;
+}
+
+std::string label(const Case& c) {
+  return c.model_params.contains("n_x") ? c.model + "_nx" + c.model_params["n_x"].dump() : c.model;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (const Case& c : paper_cases()) {
+    benchmark::RegisterBenchmark(("nonlinearity/" + label(c)).c_str(), nonlinearity, c);
+    benchmark::RegisterBenchmark(("fft_bound/" + label(c)).c_str(), fft_bound, c);
+    if (c.model_params.value("n_x", 16) != 16) continue;  // steps at the paper's sizes only
+    for (const auto* s : registry().schemes()) {
+      const auto& r = s->traits.reformulations;
+      if (std::find(r.begin(), r.end(), "two-scale") != r.end())
+        benchmark::RegisterBenchmark(("step/" + label(c) + "/" + s->info.name).c_str(), step, c, s->info.name);
+    }
+  }
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

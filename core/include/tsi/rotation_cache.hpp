@@ -1,0 +1,35 @@
+#pragma once
+#include <array>
+
+#include "tsi/types.hpp"
+
+namespace tsi {
+
+/// cos and sin of a set of phases, recomputed only when the phases change. The linear flows
+/// of the models are rotations applied to the same tau grid (and its negative) at every
+/// evaluation, so two entries remove all trigonometry from a step. Not thread-safe: a model
+/// instance serves one run.
+class RotationCache {
+ public:
+  struct Table {
+    RealVector taus, cos, sin;
+  };
+
+  /// The table for `taus`, from the cache when the same phases were seen last or before.
+  const Table& get(const RealVector& taus) {
+    for (auto& t : tables_)
+      if (t.taus.size() == taus.size() && t.taus == taus) return t;
+    Table& t = tables_[next_];
+    next_ = (next_ + 1) % tables_.size();
+    t.taus = taus;
+    t.cos = taus.array().cos();
+    t.sin = taus.array().sin();
+    return t;
+  }
+
+ private:
+  std::array<Table, 2> tables_;
+  size_t next_ = 0;
+};
+
+}  // namespace tsi
