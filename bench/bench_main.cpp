@@ -2,6 +2,7 @@
 //   nonlinearity/<model>   one evaluation of f_tau over the whole tau grid (one sweep's work)
 //   fft_bound/<model>      the transforms alone that one evaluation needs (back and forth)
 //   step/<model>/<scheme>  one step at h = 1/8, eps = 0.01 (counter: fixed-point sweeps)
+//   step_eps/<model>/se1/<eps>  the same at eps = 1 and 1e-6: the cost must not depend on eps
 // Models and schemes come from the registry, so a new plugin is benchmarked without edits.
 #include <benchmark/benchmark.h>
 
@@ -77,9 +78,9 @@ void fft_bound(benchmark::State& state, Case c) {
   }
 }
 
-void step(benchmark::State& state, Case c, std::string scheme) {
+void step(benchmark::State& state, Case c, std::string scheme, double eps) {
   const auto& s = registry().scheme(scheme);
-  auto model = make_model(c, 0.01);
+  auto model = make_model(c, eps);
   auto problem = two_scale(model, c, std::max(1, s.traits.initial_data_order));
   tsi::Json params = tsi::resolve_params(s.info.params, tsi::Json::object(), "bench");
   auto stepper = s.create(tsi::Params(params));
@@ -125,8 +126,11 @@ int main(int argc, char** argv) {
     for (const auto* s : registry().schemes()) {
       const auto& r = s->traits.reformulations;
       if (std::find(r.begin(), r.end(), "two-scale") != r.end())
-        benchmark::RegisterBenchmark(("step/" + label(c) + "/" + s->info.name).c_str(), step, c, s->info.name);
+        benchmark::RegisterBenchmark(("step/" + label(c) + "/" + s->info.name).c_str(), step, c, s->info.name, 0.01);
     }
+    for (double eps : {1.0, 1e-6})
+      benchmark::RegisterBenchmark(("step_eps/" + label(c) + "/se1/" + (eps == 1.0 ? "1" : "1e-6")).c_str(), step, c,
+                                   std::string("se1"), eps);
   }
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
