@@ -40,6 +40,8 @@ void FftBatch::forward() {
   data() *= 1.0 / n_;
 }
 
+void FftBatch::forward_unnormalised() { fftw_execute(static_cast<fftw_plan>(forward_plan_)); }
+
 void FftBatch::backward() { fftw_execute(static_cast<fftw_plan>(backward_plan_)); }
 
 }  // namespace tsi

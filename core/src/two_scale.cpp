@@ -18,8 +18,7 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
       wave_numbers_(n_tau),
       multipliers_(dim_ * n_tau),
       fft_(n_tau, static_cast<int>(model_->dim())),
-      field_(dim_, n_tau),
-      grid_(dim_, n_tau) {
+      field_fft_(n_tau, static_cast<int>(model_->dim())) {
   if (n_tau <= 0 || n_tau % 2 != 0)
     throw ConfigError("reformulation.n_tau",
                       "got " + std::to_string(n_tau) + ", expected a positive even integer");
@@ -38,16 +37,16 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
 
 void TwoScale::nonlinear(double /*t*/, const Vector& y, Vector& out) {
   ++evaluations_;
-  auto buffer = fft_.data();
-  buffer = Eigen::Map<const Matrix>(y.data(), dim_, n_tau_);
+  auto grid = fft_.data();
+  auto field = field_fft_.data();
+  grid = Eigen::Map<const Matrix>(y.data(), dim_, n_tau_);
   fft_.backward();
-  model_->linear_flow(taus_, buffer);
-  model_->nonlinear_field(buffer, field_);
-  model_->linear_flow(minus_taus_, field_);
-  buffer = field_;
-  fft_.forward();
+  model_->linear_flow(taus_, grid);
+  model_->nonlinear_field(grid, field);
+  model_->linear_flow(minus_taus_, field);
+  field_fft_.forward_unnormalised();
   out.resize(size());
-  Eigen::Map<Matrix>(out.data(), dim_, n_tau_) = buffer;
+  Eigen::Map<Matrix>(out.data(), dim_, n_tau_) = field * (1.0 / n_tau_);  // the 1/n of the transform
 }
 
 void TwoScale::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& dy, Vector& out) {

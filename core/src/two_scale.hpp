@@ -48,8 +48,8 @@ class TwoScale final : public Reformulation {
   RealVector taus_, minus_taus_;
   RealVector wave_numbers_;  // k of each Fourier index; the Nyquist index holds n/2
   Vector multipliers_;
-  FftBatch fft_;
-  Matrix field_, grid_;  // work space: no allocation inside a step
+  FftBatch fft_;        // U's coefficients -> its values on the tau grid
+  FftBatch field_fft_;  // f_tau(U) on the grid -> its coefficients: the model writes here
 };
 
 }  // namespace tsi

@@ -21,6 +21,8 @@ class TSI_API FftBatch {
   Eigen::Map<Matrix> data();
   /// Values at tau_j = 2*pi*j/n -> Fourier coefficients (normalised by 1/n).
   void forward();
+  /// The same without the 1/n: for callers that fold the normalisation into their next pass.
+  void forward_unnormalised();
   /// Fourier coefficients -> values at tau_j.
   void backward();
 
