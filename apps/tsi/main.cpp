@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "check_command.hpp"
 #include "config.hpp"
 #include "list_command.hpp"
 #include "plugin_setup.hpp"
@@ -85,6 +86,18 @@ int main(int argc, char** argv) {
   study->add_option("--set", study_overrides, "override a value of the base config: key.path=value");
   study->add_flag("--no-plots", no_plots, "do not call the plotting script");
 
+  // tsi check [MODEL] [--plugin FILE] [--scheme NAME] [--eps EPS] (check_command.hpp)
+  auto* check = app.add_subcommand("check", "run the conformance checks on a model or plugin");
+  tsi::app::CheckOptions check_options;
+  check->add_option("model", check_options.model, "the model to check (default: the plugins' models, or all)");
+  check->add_option("--plugin", check_options.plugins, "load this plugin and check what it provides")
+      ->check(CLI::ExistingFile);
+  check->add_option("--scheme", check_options.schemes, "check with this two-scale scheme only (repeatable)");
+  check->add_option("--eps", check_options.epsilons, "eps of the order checks (repeatable; default 1 and 1e-3)");
+  // The runner's own options (--plugin) may also follow a subcommand: tsi run CONFIG --plugin FILE.
+  for (auto* sub : app.get_subcommands([](CLI::App*) { return true; })) sub->fallthrough();
+  // end tsi check
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -101,6 +114,7 @@ int main(int argc, char** argv) {
                                : tsi::app::list_text(registry, what));
       return 0;
     }
+    if (check->parsed()) return tsi::app::check_command(loader, registry, check_options, plugin_files);
     if (study->parsed())
       return tsi::app::study_command(loader, registry, study_path, study_out, jobs, study_overrides, !no_plots);
     return run_command(loader, registry, config_path, out_dir, overrides);

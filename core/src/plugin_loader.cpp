@@ -13,6 +13,12 @@
 #ifndef TSI_BUILD_PLUGIN_DIR
 #define TSI_BUILD_PLUGIN_DIR ""
 #endif
+#ifndef TSI_PLUGIN_DIR_FROM_BIN
+#define TSI_PLUGIN_DIR_FROM_BIN "../lib/tsi/plugins"
+#endif
+#ifndef TSI_PLUGIN_DIR_FROM_LIB
+#define TSI_PLUGIN_DIR_FROM_LIB "tsi/plugins"
+#endif
 
 namespace tsi {
 
@@ -39,7 +45,47 @@ bool provides(const Registry& registry, const std::string& provider) {
   return any(registry.models()) || any(registry.reformulations()) || any(registry.schemes());
 }
 
-/// The plugin's info block, after the ABI, size and version checks; throws the reason.
+/// Describes one layout as "N bytes, alignment A".
+std::string describe(const TsiTypeLayout& l) {
+  return std::to_string(l.size) + " bytes, alignment " + std::to_string(l.align);
+}
+
+/// Refuses a plugin whose exchanged structures differ from this tsi's, naming the first one.
+void check_layout(const std::string& path, const TsiPluginLayout& theirs) {
+  static constexpr TsiPluginLayout ours = tsi_plugin_layout();
+  struct Field {
+    const char* type;
+    TsiTypeLayout TsiPluginLayout::*member;
+  };
+  static constexpr Field fields[] = {
+      {"tsi::EntryInfo", &TsiPluginLayout::entry_info},
+      {"tsi::ParamSpec", &TsiPluginLayout::param_spec},
+      {"tsi::ModelEntry", &TsiPluginLayout::model_entry},
+      {"tsi::ReformulationEntry", &TsiPluginLayout::reformulation_entry},
+      {"tsi::SchemeEntry", &TsiPluginLayout::scheme_entry},
+      {"tsi::StepperTraits", &TsiPluginLayout::stepper_traits},
+      {"tsi::Model", &TsiPluginLayout::model},
+      {"tsi::Stepper", &TsiPluginLayout::stepper},
+      {"tsi::Params", &TsiPluginLayout::params},
+      {"tsi::Vector", &TsiPluginLayout::vector},
+      {"tsi::Json", &TsiPluginLayout::json},
+      {"std::string", &TsiPluginLayout::string}};
+  for (const auto& f : fields) {
+    const TsiTypeLayout& a = theirs.*f.member;
+    const TsiTypeLayout& b = ours.*f.member;
+    if (a.size != b.size || a.align != b.align)
+      throw PluginError(path + ": " + f.type + " is " + describe(a) + " in the plugin, " + describe(b) +
+                        " in this tsi (built against other tsi headers or an incompatible "
+                        "toolchain: rebuild the plugin against this tsi)");
+  }
+  if (theirs.eigen_max_align_bytes != ours.eigen_max_align_bytes)
+    throw PluginError(path + ": built with EIGEN_MAX_ALIGN_BYTES " +
+                      std::to_string(theirs.eigen_max_align_bytes) + ", this tsi uses " +
+                      std::to_string(ours.eigen_max_align_bytes) +
+                      " (vectors cross the plugin boundary: build both with the same flags)");
+}
+
+/// The plugin's info block, after the ABI, size, version and layout checks; throws the reason.
 const TsiPluginInfo& open_plugin(const std::string& path) {
   dlerror();
   void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
@@ -69,6 +115,7 @@ const TsiPluginInfo& open_plugin(const std::string& path) {
     throw PluginError(path + ": built for tsi " + theirs + ", this is tsi " + version_string +
                       " (major versions differ)");
   }
+  check_layout(path, info->layout);
   if (!info->register_fn) throw PluginError(path + ": plugin has no register function");
   return *info;
 }
@@ -152,13 +199,21 @@ std::vector<PluginLoadReport> PluginLoader::load_path_list(const std::string& li
 }
 
 std::string PluginLoader::default_directory() {
+  // Next to the running executable (an installed runner: <prefix>/bin/../lib/tsi/plugins),
+  // then next to this library (any program linked against an installed libtsi_core), then
+  // the build tree's.
+  std::vector<fs::path> candidates;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    const fs::path installed = exe.parent_path() / ".." / "lib" / "tsi" / "plugins";
-    if (fs::is_directory(installed, ec)) {
-      const fs::path clean = fs::weakly_canonical(installed, ec);
-      return ec ? installed.string() : clean.string();
+  if (!ec) candidates.push_back(exe.parent_path() / TSI_PLUGIN_DIR_FROM_BIN);
+  static const char anchor = 0;  // an address inside libtsi_core
+  Dl_info self{};
+  if (dladdr(&anchor, &self) != 0 && self.dli_fname)
+    candidates.push_back(fs::path(self.dli_fname).parent_path() / TSI_PLUGIN_DIR_FROM_LIB);
+  for (const auto& dir : candidates) {
+    if (fs::is_directory(dir, ec)) {
+      const fs::path clean = fs::weakly_canonical(dir, ec);
+      return ec ? dir.string() : clean.string();
     }
   }
   return TSI_BUILD_PLUGIN_DIR;

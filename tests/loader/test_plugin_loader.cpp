@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "tsi/error.hpp"
+#include "tsi/plugin.hpp"
 #include "tsi/plugin_loader.hpp"
 #include "tsi/version.hpp"
 
@@ -71,7 +72,26 @@ TEST_CASE("loader: loading the same file twice is a no-op") {
 }
 
 TEST_CASE("loader: a plugin for another ABI is refused") {
-  expect_refused(fixture("wrong_abi"), "built for plugin ABI 999, this tsi speaks ABI 1");
+  expect_refused(fixture("wrong_abi"), "built for plugin ABI 999, this tsi speaks ABI " +
+                                           std::to_string(TSI_PLUGIN_ABI_VERSION));
+}
+
+TEST_CASE("loader: a plugin whose structures differ in size is refused, naming the structure") {
+  const TsiTypeLayout ours = tsi_plugin_layout().model_entry;
+  const std::string both = "tsi::ModelEntry is " + std::to_string(ours.size + 8) + " bytes, alignment " +
+                           std::to_string(ours.align) + " in the plugin, " + std::to_string(ours.size) +
+                           " bytes, alignment " + std::to_string(ours.align) + " in this tsi";
+  expect_refused(fixture("wrong_layout"), both);
+}
+
+TEST_CASE("loader: the layout handshake covers the exchanged structures") {
+  constexpr TsiPluginLayout layout = tsi_plugin_layout();
+  CHECK(layout.model_entry.size == sizeof(tsi::ModelEntry));
+  CHECK(layout.scheme_entry.size == sizeof(tsi::SchemeEntry));
+  CHECK(layout.entry_info.size == sizeof(tsi::EntryInfo));
+  CHECK(layout.entry_info.align == alignof(tsi::EntryInfo));
+  CHECK(layout.eigen_max_align_bytes == EIGEN_MAX_ALIGN_BYTES);
+  CHECK(TSI_PLUGIN_ABI_VERSION == 2);
 }
 
 TEST_CASE("loader: a plugin for another tsi major version is refused") {
@@ -113,20 +133,22 @@ TEST_CASE("loader: a directory scan collects failures without throwing") {
   tsi::PluginLoader loader(r);
   std::vector<tsi::PluginLoadReport> reports;
   CHECK_NOTHROW(reports = loader.load_directory(TSI_TEST_FIXTURE_DIR));
-  // Sorted: duplicate loads first into the empty registry, so good then clashes with it.
-  std::vector<std::string> expected;
-  for (const char* n : {"duplicate", "good", "no_entry", "throws", "wrong_abi", "wrong_major"}) {
-    expected.push_back(fixture(n));
-  }
+  // Sorted: duplicate loads before good into the empty registry, so good clashes with it;
+  // shipped_duplicate's "henon-heiles" is free here (no shipped plugins in this registry).
+  const std::vector<std::pair<const char*, bool>> expected = {
+      {"broken_flow", true}, {"duplicate", true},         {"good", false},
+      {"no_entry", false},   {"shipped_duplicate", true}, {"throws", false},
+      {"wrong_abi", false},  {"wrong_layout", false},     {"wrong_major", false}};
   REQUIRE(reports.size() == expected.size());
   for (std::size_t i = 0; i < reports.size(); ++i) {
     CAPTURE(reports[i].path);
-    CHECK(reports[i].path == expected[i]);
-    CHECK(reports[i].ok == (i == 0));
-    CHECK(reports[i].error.empty() == (i == 0));
+    CHECK(reports[i].path == fixture(expected[i].first));
+    CHECK(reports[i].ok == expected[i].second);
+    CHECK(reports[i].error.empty() == expected[i].second);
   }
-  CHECK(reports[1].error.find("already registered") != std::string::npos);
-  CHECK(r.scheme("fixture-duplicate-scheme").info.provider == expected[0]);
+  CHECK(reports[2].error.find("already registered") != std::string::npos);
+  CHECK(reports[7].error.find("tsi::ModelEntry") != std::string::npos);
+  CHECK(r.scheme("fixture-duplicate-scheme").info.provider == fixture("duplicate"));
   CHECK(loader.reports().size() == reports.size());
 }
 

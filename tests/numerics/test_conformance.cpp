@@ -3,6 +3,8 @@
 // uniform second order at T = 1, and time symmetry exactly where the scheme declares it.
 #include <doctest/doctest.h>
 
+#include <cmath>
+
 #include <algorithm>
 
 #include "harness.hpp"
@@ -61,7 +63,7 @@ TEST_CASE("conformance: every two-scale scheme is uniformly second order on Heno
       const double order = tsi::least_squares_order(hs, errors[k]);
       CAPTURE(epsilons[k]);
       CAPTURE(order);
-      CHECK(order == doctest::Approx(2.0).epsilon(0.075));  // 2 +- 0.15
+      CHECK(std::abs(order - 2.0) <= 0.15);
     }
     for (size_t i = 0; i < hs.size(); ++i) {
       double largest = 0.0;

@@ -2,6 +2,8 @@
 // that is recorded without stopping the others.
 #include <doctest/doctest.h>
 
+#include <cmath>
+
 #include <map>
 #include <set>
 #include <string>
@@ -42,7 +44,7 @@ TEST_CASE("study: table.csv, study.json and one result per run, with orders and 
   for (const auto& row : study["table"]) {
     CHECK(row["status"] == "completed");
     CHECK(fs::is_regular_file(fs::path(out) / "runs" / row["id"].get<std::string>() / "result.json"));
-    if (row["h"].get<double>() < 0.25) CHECK(row["order"].get<double>() == doctest::Approx(2.0).epsilon(0.1));
+    if (row["h"].get<double>() < 0.25) CHECK(std::abs(row["order"].get<double>() - 2.0) <= 0.15);
   }
   CHECK(study["convergence"]["series"].size() == 4);
   CHECK(study["convergence"]["uniform"].size() == 2);

@@ -37,7 +37,7 @@ tsi::FixedPointOptions options(const std::string& method, double tol, int max_it
 
 }  // namespace
 
-TEST_CASE("Picard and Anderson reach the same fixed point; Anderson in fewer sweeps") {
+TEST_CASE("Picard and Anderson reach the same fixed point, Anderson in fewer sweeps") {
   const AffineMap g;
   const tsi::Vector exact = g.fixed_point();
   long sweeps[2];

@@ -44,6 +44,12 @@ class TSI_API Model {
   /// Energy H(u) = I(u) + H1(u), exactly conserved by the flow.
   double energy(const Vector& u) const { return oscillatory_energy(u) + H1(u); }
 
+  /// The largest |lambda| over the eigenvalues i*lambda of JM (integers, since e^{JM tau} is
+  /// 2*pi-periodic): e^{JM tau} oscillates with frequencies up to this. 1 by default
+  /// (Henon-Heiles, charged particle); NLS: (N_x/2)^2. The filtered problem's explicit time
+  /// dependence has period 2*pi*eps / max_linear_frequency() at its fastest.
+  virtual double max_linear_frequency() const { return 1.0; }
+
   /// True when the model solves u' = J grad H1(u) exactly (splitting schemes need it).
   virtual bool has_exact_nonlinear_flow() const { return false; }
   /// u <- the exact flow of u' = J grad H1(u) over time t. The default throws tsi::Error.

@@ -1,16 +1,49 @@
 #pragma once
 #include <cstdint>
+#include <string>
 
 #include "tsi/export.hpp"
+#include "tsi/params.hpp"
 #include "tsi/registry.hpp"
+#include "tsi/types.hpp"
 #include "tsi/version.hpp"
 
-/// The plugin ABI (LLVM pass-plugin style): a plugin exports one C function,
-/// tsi_plugin_entry, returning a TsiPluginInfo. The loader checks the ABI version, the
-/// size of the structure and the tsi major version before calling register_fn.
-inline constexpr std::uint32_t TSI_PLUGIN_ABI_VERSION = 1;
+/// The plugin ABI (LLVM pass-plugin style, with gz-plugin's size handshake): a plugin exports
+/// one C function, tsi_plugin_entry, returning a TsiPluginInfo. The loader checks, in this
+/// order, the ABI version, the size of TsiPluginInfo, the tsi major version and the layout of
+/// every structure the plugin exchanges with tsi, before it calls register_fn.
+/// What is stable and what bumps the version: docs/plugin-abi.md.
+inline constexpr std::uint32_t TSI_PLUGIN_ABI_VERSION = 2;
 
 extern "C" {
+
+/// sizeof and alignof of one type, as a translation unit saw it.
+struct TsiTypeLayout {
+  std::uint32_t size;
+  std::uint32_t align;
+};
+
+/// The layout of the structures a plugin and tsi exchange, as the plugin was compiled.
+/// A difference means the two were built from different headers or with incompatible
+/// settings (another standard library ABI, another Eigen alignment), and the plugin is refused.
+struct TsiPluginLayout {
+  TsiTypeLayout entry_info;           ///< tsi::EntryInfo
+  TsiTypeLayout param_spec;           ///< tsi::ParamSpec
+  TsiTypeLayout model_entry;          ///< tsi::ModelEntry
+  TsiTypeLayout reformulation_entry;  ///< tsi::ReformulationEntry
+  TsiTypeLayout scheme_entry;         ///< tsi::SchemeEntry
+  TsiTypeLayout stepper_traits;       ///< tsi::StepperTraits
+  TsiTypeLayout model;                ///< tsi::Model
+  TsiTypeLayout stepper;              ///< tsi::Stepper
+  TsiTypeLayout params;               ///< tsi::Params
+  TsiTypeLayout vector;               ///< tsi::Vector (Eigen::VectorXcd)
+  TsiTypeLayout json;                 ///< tsi::Json (nlohmann::json)
+  TsiTypeLayout string;               ///< std::string
+  /// EIGEN_MAX_ALIGN_BYTES: vectors resized by the plugin are freed by tsi and the other way
+  /// round, so both must allocate with the same alignment.
+  std::uint32_t eigen_max_align_bytes;
+};
+
 struct TsiPluginInfo {
   std::uint32_t abi_version;  ///< TSI_PLUGIN_ABI_VERSION the plugin was built with
   std::uint32_t info_size;    ///< sizeof(TsiPluginInfo) the plugin was built with
@@ -18,17 +51,46 @@ struct TsiPluginInfo {
   const char* tsi_version;    ///< tsi::version_string the plugin was built with
   const char* name;           ///< the plugin's own name
   void (*register_fn)(tsi::Registry&);  ///< adds the plugin's models and schemes
+  TsiPluginLayout layout;     ///< tsi_plugin_layout() as the plugin was compiled
 };
+}
+
+namespace tsi::detail {
+template <class T>
+constexpr TsiTypeLayout layout_of() {
+  return {static_cast<std::uint32_t>(sizeof(T)), static_cast<std::uint32_t>(alignof(T))};
+}
+}  // namespace tsi::detail
+
+/// The layout of the exchanged structures in the calling translation unit: the plugin's
+/// entry point records its own, the loader compares it with tsi's.
+constexpr TsiPluginLayout tsi_plugin_layout() {
+  using tsi::detail::layout_of;
+  return {layout_of<tsi::EntryInfo>(),
+          layout_of<tsi::ParamSpec>(),
+          layout_of<tsi::ModelEntry>(),
+          layout_of<tsi::ReformulationEntry>(),
+          layout_of<tsi::SchemeEntry>(),
+          layout_of<tsi::StepperTraits>(),
+          layout_of<tsi::Model>(),
+          layout_of<tsi::Stepper>(),
+          layout_of<tsi::Params>(),
+          layout_of<tsi::Vector>(),
+          layout_of<tsi::Json>(),
+          layout_of<std::string>(),
+          static_cast<std::uint32_t>(EIGEN_MAX_ALIGN_BYTES)};
 }
 
 /// Name of the entry point the loader looks up.
 #define TSI_PLUGIN_ENTRY_NAME "tsi_plugin_entry"
 
 /// Defines the entry point of a plugin: TSI_PLUGIN("my-plugin", my_register_function).
-#define TSI_PLUGIN(NAME, REGISTER_FN)                                                       \
-  extern "C" TSI_API const TsiPluginInfo* tsi_plugin_entry() {                             \
-    static const TsiPluginInfo info{TSI_PLUGIN_ABI_VERSION, sizeof(TsiPluginInfo),          \
-                                    tsi::version_major, tsi::version_string, NAME,          \
-                                    REGISTER_FN};                                            \
-    return &info;                                                                            \
+/// `my_register_function` is a void(tsi::Registry&) that adds the plugin's entries.
+#define TSI_PLUGIN(NAME, REGISTER_FN)                                                   \
+  extern "C" TSI_API const TsiPluginInfo* tsi_plugin_entry() {                          \
+    static const TsiPluginInfo info{TSI_PLUGIN_ABI_VERSION, sizeof(TsiPluginInfo),      \
+                                    tsi::version_major,     tsi::version_string,        \
+                                    NAME,                   REGISTER_FN,                \
+                                    tsi_plugin_layout()};                               \
+    return &info;                                                                       \
   }

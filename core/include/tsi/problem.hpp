@@ -19,7 +19,8 @@ class TSI_API Problem {
   bool has_diagonal_linear_part() const { return linear_multipliers().size() == size(); }
   /// True when N does not depend on t.
   virtual bool autonomous() const = 0;
-  /// The period in t of the explicit time dependence (filtered: 2 pi eps), 0 if none.
+  /// The period in t of the fastest component of the explicit time dependence (filtered:
+  /// 2 pi eps / Model::max_linear_frequency()), 0 if none.
   /// Adaptive solvers must not step across it: their error estimates alias.
   virtual double fast_period() const { return 0.0; }
 

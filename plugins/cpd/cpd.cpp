@@ -1,0 +1,188 @@
+// Charged particle in a strong magnetic field (eq. CPD, eq. model CPD F; SPEC.md section 4):
+//     x' = v,   v' = (1/eps) B v + g(x),   B = [[0, 1], [-1, 0]],   g = -grad U.
+// Canonical variables u = (q, p), q = x, p = 2 eps v - B x:
+//     M = (1/2) [[I2, -B], [B, I2]],   J = [[0, I2], [-I2, 0]],   H1(q, p) = 2 eps U(q),
+// so q' = (1/(2 eps)) (B q + p) = v and p' = (1/(2 eps)) (B p - q) - 2 eps grad U(q) = B v + 2 eps g.
+// Initial values, output and errors are in the physical variables (x, v), v = (p + B q)/(2 eps).
+//
+// The linear flow: JM = (1/2) (diag(B, B) + K (x) I2) with K = [[0, 1], [-1, 0]] acting on
+// the (q, p) blocks; the two terms commute, e^{s B} = R(s) = [[cos s, sin s], [-sin s, cos s]]
+// and e^{s K (x) I2} = [[cos s I2, sin s I2], [-sin s I2, cos s I2]]. With s = tau/2:
+//     e^{JM tau} = [[c R, s R], [-s R, c R]],   R = [[c, s], [-s, c]],   c = cos(tau/2), s = sin(tau/2).
+// Eigenvalues of JM: (+-i +- i)/2 = 0, 0, +i, -i; at tau = 2 pi, R = -I2 and c = -1: the identity.
+#include <array>
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "tsi/error.hpp"
+#include "tsi/model.hpp"
+#include "tsi/plugin.hpp"
+
+namespace {
+
+using tsi::Complex;
+using tsi::ConstMatrixRef;
+using tsi::Index;
+using tsi::MatrixRef;
+using tsi::Vector;
+
+enum class Potential { Coulomb, Harmonic };
+
+class ChargedParticle final : public tsi::Model {
+ public:
+  ChargedParticle(double eps, Potential potential) : Model(eps), potential_(potential) {}
+  using Model::linear_flow;
+  using Model::nonlinear_field;
+
+  Index dim() const override { return 4; }
+  bool is_complex() const override { return false; }
+
+  void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
+    const HalfAngles& table = half_angles(taus);
+    for (Index j = 0; j < u.cols(); ++j) {
+      const double c = table.cos(j), s = table.sin(j);
+      const Complex q1 = u(0, j), q2 = u(1, j), p1 = u(2, j), p2 = u(3, j);
+      // a = c q + s p, b = -s q + c p, then R applied to both.
+      const Complex a1 = c * q1 + s * p1, a2 = c * q2 + s * p2;
+      const Complex b1 = -s * q1 + c * p1, b2 = -s * q2 + c * p2;
+      u(0, j) = c * a1 + s * a2;
+      u(1, j) = -s * a1 + c * a2;
+      u(2, j) = c * b1 + s * b2;
+      u(3, j) = -s * b1 + c * b2;
+    }
+  }
+
+  // J grad H1 = (dH1/dp, -dH1/dq) = (0, -2 eps grad U(q)). Coulomb: grad U = -q / |q|^3, with
+  // |q|^2 = q1^2 + q2^2 continued analytically to complex q (the derivative below matches).
+  void nonlinear_field(ConstMatrixRef u, MatrixRef out) const override {
+    const double two_eps = 2.0 * eps();
+    for (Index j = 0; j < u.cols(); ++j) {
+      const Complex q1 = u(0, j), q2 = u(1, j);
+      Complex k;  // p' = k q
+      if (potential_ == Potential::Coulomb) {
+        const Complex r2 = q1 * q1 + q2 * q2;
+        k = two_eps / (r2 * std::sqrt(r2));
+      } else {
+        k = -two_eps;
+      }
+      out(0, j) = 0.0;
+      out(1, j) = 0.0;
+      out(2, j) = k * q1;
+      out(3, j) = k * q2;
+    }
+  }
+
+  // D[2 eps q |q|^{-3}] z = 2 eps (z |q|^{-3} - 3 q (q . z) |q|^{-5}).
+  void nonlinear_field_derivative(ConstMatrixRef u, ConstMatrixRef z, MatrixRef out) const override {
+    const double two_eps = 2.0 * eps();
+    for (Index j = 0; j < u.cols(); ++j) {
+      const Complex q1 = u(0, j), q2 = u(1, j), z1 = z(0, j), z2 = z(1, j);
+      out(0, j) = 0.0;
+      out(1, j) = 0.0;
+      if (potential_ == Potential::Coulomb) {
+        const Complex r2 = q1 * q1 + q2 * q2;
+        const Complex inv3 = 1.0 / (r2 * std::sqrt(r2)), qz = q1 * z1 + q2 * z2;
+        out(2, j) = two_eps * (z1 * inv3 - 3.0 * q1 * qz * inv3 / r2);
+        out(3, j) = two_eps * (z2 * inv3 - 3.0 * q2 * qz * inv3 / r2);
+      } else {
+        out(2, j) = -two_eps * z1;
+        out(3, j) = -two_eps * z2;
+      }
+    }
+  }
+
+  // M = (1/2) [[I2, -B], [B, I2]], B (a, b) = (b, -a).
+  void apply_M(const Vector& u, Vector& out) const override {
+    const Complex q1 = u(0), q2 = u(1), p1 = u(2), p2 = u(3);
+    out.resize(4);
+    out << 0.5 * (q1 - p2), 0.5 * (q2 + p1), 0.5 * (q2 + p1), 0.5 * (-q1 + p2);
+  }
+
+  void apply_J(const Vector& u, Vector& out) const override {
+    out.resize(4);
+    out << u(2), u(3), -u(0), -u(1);
+  }
+
+  double H1(const Vector& u) const override { return 2.0 * eps() * potential(u(0).real(), u(1).real()); }
+
+  bool has_exact_nonlinear_flow() const override { return true; }
+
+  // q' = 0, p' = -2 eps grad U(q): q fixed, p moves linearly in t.
+  void nonlinear_flow(double t, Vector& u) const override {
+    Vector field = nonlinear_field(u);
+    u(2) += t * field(2);
+    u(3) += t * field(3);
+  }
+
+  Vector initial_value() const override {
+    Vector x(4);
+    x << 0.8, 0.9, 0.5, 0.6;
+    return from_physical(x);
+  }
+
+  // (x, v) -> (q, p) = (x, 2 eps v - B x).
+  Vector from_physical(const Vector& x) const override {
+    Vector u(4);
+    u << x(0), x(1), 2.0 * eps() * x(2) - x(1), 2.0 * eps() * x(3) + x(0);
+    return u;
+  }
+
+  // (q, p) -> (x, v) = (q, (p + B q) / (2 eps)).
+  Vector to_physical(const Vector& u) const override {
+    Vector x(4);
+    const double inv = 1.0 / (2.0 * eps());
+    x << u(0), u(1), (u(2) + u(1)) * inv, (u(3) - u(0)) * inv;
+    return x;
+  }
+
+ private:
+  struct HalfAngles {
+    tsi::RealVector taus, cos, sin;  // cos(tau/2), sin(tau/2)
+  };
+
+  // The tables of the last two tau sets (the two-scale grid and its negative come back at
+  // every evaluation). Not thread-safe: a model instance serves one run.
+  const HalfAngles& half_angles(const tsi::RealVector& taus) const {
+    for (auto& t : tables_)
+      if (t.taus.size() == taus.size() && t.taus == taus) return t;
+    HalfAngles& t = tables_[next_table_];
+    next_table_ = (next_table_ + 1) % tables_.size();
+    t.taus = taus;
+    t.cos = (0.5 * taus.array()).cos();
+    t.sin = (0.5 * taus.array()).sin();
+    return t;
+  }
+
+  double potential(double x1, double x2) const {
+    const double r2 = x1 * x1 + x2 * x2;
+    return potential_ == Potential::Coulomb ? 1.0 / std::sqrt(r2) : 0.5 * r2;
+  }
+
+  Potential potential_;
+  mutable std::array<HalfAngles, 2> tables_;
+  mutable size_t next_table_ = 0;
+};
+
+void register_cpd(tsi::Registry& registry) {
+  tsi::ModelEntry entry;
+  entry.info.name = "cpd";
+  entry.info.aliases = {"charged-particle"};
+  entry.info.summary =
+      "charged particle in a strong magnetic field (eq. model CPD F), canonical (q, p) inside, "
+      "physical (x, v) outside, dim 4";
+  entry.info.params = {tsi::string_param("potential", "coulomb",
+                                         "U(x): \"coulomb\" 1/|x| (the paper's) or \"harmonic\" |x|^2/2")
+                           .choices({"coulomb", "harmonic"})};
+  entry.default_n_tau = 64;
+  entry.create = [](const tsi::Params& p) {
+    const Potential potential =
+        p.string("potential") == "harmonic" ? Potential::Harmonic : Potential::Coulomb;
+    return std::make_unique<ChargedParticle>(p.number("eps"), potential);
+  };
+  registry.add_model(std::move(entry));
+}
+
+}  // namespace
+
+TSI_PLUGIN("cpd", register_cpd)

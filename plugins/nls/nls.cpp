@@ -1,0 +1,260 @@
+// The cubic nonlinear Schroedinger equation on the torus (eq. NLS eq; SPEC.md section 4):
+//     i u_t = -(1/eps) u_xx + |u|^2 u,   x in [0, 2 pi) periodic,
+// discretised by the Fourier pseudospectral method with N_x points x_j = 2 pi j / N_x.
+//
+// State: the N_x Fourier coefficients c_m = sqrt(2 pi) * uhat_m of u(x) = sum_m uhat_m e^{i m x},
+// in FFT order (index k holds the wave number m = k for k < N_x/2, m = k - N_x above; the
+// Nyquist mode only enters through m^2). With this normalisation sum |c_m|^2 is the discrete
+// ||u||_{L2}^2 (Parseval), so the default mass <c, c> is SPEC's m, and
+//     J = -i/2,   M = 2 diag(m^2),   H1 = (1/2) ||u||_{L4}^4 = (pi/N_x) sum_j |u_j|^4
+// give I = (1/(2 eps)) <Mc, c> = (1/eps) ||u_x||_{L2}^2, (1/eps) J M c = -(i/eps) m^2 c (the
+// linear part of the equation), and J grad H1 = -i |u|^2 u in physical space. The
+// semi-discrete system is Hamiltonian for exactly this H1, so H = I + H1 is its invariant.
+//
+// Physical variables are the samples u_j on the x grid: to_physical is the inverse transform,
+// from_physical the forward one, and errors are measured in the discrete L2 norm
+// sqrt(2 pi / N_x) |u|.
+#include <array>
+#include <cmath>
+#include <complex>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "tsi/error.hpp"
+#include "tsi/fft.hpp"
+#include "tsi/model.hpp"
+#include "tsi/phase.hpp"
+#include "tsi/plugin.hpp"
+
+namespace {
+
+using tsi::Complex;
+using tsi::ConstMatrixRef;
+using tsi::Index;
+using tsi::MatrixRef;
+using tsi::Vector;
+
+/// Transforms along x of `columns` states of n_x entries each, all columns in one batched
+/// transform each way. tsi::FftBatch transforms along the second index of a
+/// (howmany x n) buffer, so the states are stored transposed, one per row; its plans are made
+/// once, under the core's FFTW planner lock (runs of a study plan on several threads).
+class XBatch {
+ public:
+  XBatch(int n_x, Index columns) : fft_(n_x, static_cast<int>(columns)), scratch_(columns, n_x) {}
+
+  /// columns x n_x: row j is state j (physical samples or Fourier coefficients).
+  Eigen::Map<tsi::Matrix> data() { return fft_.data(); }
+  /// Unnormalised: sum_j a_j e^{-2 pi i j k / n_x}.
+  void forward() { fft_.forward_unnormalised(); }
+  /// Unnormalised: sum_k a_k e^{+2 pi i j k / n_x}.
+  void backward() { fft_.backward(); }
+  /// Work space of the same shape (the second grid of a derivative).
+  tsi::Matrix& scratch() { return scratch_; }
+
+ private:
+  tsi::FftBatch fft_;
+  tsi::Matrix scratch_;
+};
+
+class Nls final : public tsi::Model {
+ public:
+  Nls(double eps, int n_x) : Model(eps), n_x_(n_x), wave_numbers_(n_x) {
+    for (int k = 0; k < n_x; ++k) wave_numbers_(k) = 2 * k < n_x ? k : k - n_x;
+    batch(1);  // the single-state plans (filtered, direct, invariants)
+  }
+
+  Index dim() const override { return n_x_; }
+  bool is_complex() const override { return true; }
+
+  // e^{JM tau}: mode m times e^{-i m^2 tau}, with the phases of the last two tau sets cached
+  // (the two-scale grid and its negative come back at every evaluation).
+  void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const tsi::Matrix& phase = phases(taus);
+    const int half = n_x_ / 2;
+    for (Index j = 0; j < u.cols(); ++j)
+      for (int m = 1; m <= half; ++m) {
+        u(m, j) *= phase(m, j);
+        if (n_x_ - m != m) u(n_x_ - m, j) *= phase(m, j);
+      }
+  }
+
+  // -i |u|^2 u on the grid, for all columns in one batched transform each way.
+  // With w = backward(c) = sqrt(2 pi) u:  out = -i forward(|w|^2 w) / (2 pi N_x).
+  void nonlinear_field(ConstMatrixRef c, MatrixRef out) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    XBatch& b = batch(c.cols());
+    auto w = b.data();  // row j: state j
+    w = c.transpose();
+    b.backward();
+    const Complex scale(0.0, -1.0 / (tsi::two_pi * n_x_));
+    for (Index i = 0; i < n_x_; ++i)
+      for (Index j = 0; j < w.rows(); ++j) w(j, i) *= scale * std::norm(w(j, i));
+    b.forward();
+    out = w.transpose();
+  }
+
+  // D(-i |u|^2 u) z = -i (2 |u|^2 z + u^2 conj(z)), on the grid, same scaling as above.
+  void nonlinear_field_derivative(ConstMatrixRef c, ConstMatrixRef dc, MatrixRef out) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    XBatch& b = batch(c.cols());
+    tsi::Matrix& grid = b.scratch();
+    auto w = b.data();  // row j: state j
+    w = c.transpose();
+    b.backward();
+    grid = w;
+    w = dc.transpose();
+    b.backward();
+    const Complex scale(0.0, -1.0 / (tsi::two_pi * n_x_));
+    for (Index i = 0; i < n_x_; ++i)
+      for (Index j = 0; j < w.rows(); ++j) {
+        const Complex g = grid(j, i), z = w(j, i);
+        w(j, i) = scale * (2.0 * std::norm(g) * z + g * g * std::conj(z));
+      }
+    b.forward();
+    out = w.transpose();
+  }
+
+  void apply_M(const Vector& u, Vector& out) const override {
+    out.resize(n_x_);
+    for (Index k = 0; k < n_x_; ++k) out(k) = 2.0 * wave_numbers_(k) * wave_numbers_(k) * u(k);
+  }
+
+  void apply_J(const Vector& u, Vector& out) const override { out = Complex(0.0, -0.5) * u; }
+
+  // (1/2) ||u||_{L4}^4 = (pi / N_x) sum |u_j|^4 = sum |w_j|^4 / (4 pi N_x).
+  double H1(const Vector& c) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    XBatch& b = batch(1);
+    auto w = b.data();
+    w.row(0) = c.transpose();
+    b.backward();
+    return w.row(0).cwiseAbs2().squaredNorm() / (2.0 * tsi::two_pi * n_x_);
+  }
+
+  // The fastest mode, m = N_x/2, turns with e^{-i (N_x/2)^2 tau}.
+  double max_linear_frequency() const override { return 0.25 * n_x_ * n_x_; }
+
+  bool has_exact_nonlinear_flow() const override { return true; }
+
+  // u' = -i |u|^2 u keeps |u| fixed pointwise: u -> u e^{-i |u|^2 t} on the grid.
+  void nonlinear_flow(double t, Vector& c) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    XBatch& b = batch(1);
+    auto w = b.data();
+    w.row(0) = c.transpose();
+    b.backward();
+    const double to_u2 = 1.0 / tsi::two_pi;  // |u|^2 = |w|^2 / (2 pi)
+    for (Index i = 0; i < n_x_; ++i) w(0, i) *= std::polar(1.0 / n_x_, -t * std::norm(w(0, i)) * to_u2);
+    b.forward();
+    c = w.row(0).transpose();
+  }
+
+  // u0(x) = (cos x + i sin x) / (1 + sin^2 x) (the paper's).
+  Vector initial_value() const override {
+    Vector x(n_x_);
+    for (Index j = 0; j < n_x_; ++j) {
+      const double xj = tsi::two_pi * static_cast<double>(j) / n_x_, s = std::sin(xj);
+      x(j) = std::polar(1.0, xj) / (1.0 + s * s);
+    }
+    return from_physical(x);
+  }
+
+  // Grid samples -> c = sqrt(2 pi) / N_x * forward(samples).
+  Vector from_physical(const Vector& x) const override {
+    if (x.size() != n_x_)
+      throw tsi::ConfigError(
+          "model.u0", "got " + std::to_string(x.size()) + " samples, expected n_x = " + std::to_string(n_x_));
+    std::lock_guard<std::mutex> lock(mutex_);
+    XBatch& b = batch(1);
+    auto w = b.data();
+    w.row(0) = x.transpose();
+    b.forward();
+    return w.row(0).transpose() * (std::sqrt(tsi::two_pi) / n_x_);
+  }
+
+  // c -> grid samples u_j = backward(c)_j / sqrt(2 pi).
+  Vector to_physical(const Vector& c) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    XBatch& b = batch(1);
+    auto w = b.data();
+    w.row(0) = c.transpose();
+    b.backward();
+    return w.row(0).transpose() / std::sqrt(tsi::two_pi);
+  }
+
+  // Discrete L2 norm of grid samples.
+  double error_norm(const Vector& x) const override { return std::sqrt(tsi::two_pi / n_x_) * x.norm(); }
+
+ private:
+  // The transforms for batches of `columns` states, planned on first use and kept: a run
+  // sees two or three batch sizes (1 and N_tau), so nothing is planned inside a step after
+  // the first call. Callers hold mutex_.
+  XBatch& batch(Index columns) const {
+    auto it = batches_.find(columns);
+    if (it == batches_.end())
+      it = batches_.emplace(columns, std::make_unique<XBatch>(n_x_, columns)).first;
+    return *it->second;
+  }
+
+  // e^{-i m^2 tau_j} for m = 0 .. N_x/2 (rows) and every tau_j (columns), by the recurrence
+  // e^{-i (m+1)^2 tau} = e^{-i m^2 tau} e^{-i (2m+1) tau}: one sincos per column, rounding of
+  // a few m^2 ulp (as the rounding of m^2 tau itself). Callers hold mutex_.
+  const tsi::Matrix& phases(const tsi::RealVector& taus) const {
+    for (auto& t : phase_tables_)
+      if (t.taus.size() == taus.size() && t.taus == taus) return t.phases;
+    PhaseTable& t = phase_tables_[next_table_];
+    next_table_ = (next_table_ + 1) % phase_tables_.size();
+    t.taus = taus;
+    t.phases.resize(n_x_ / 2 + 1, taus.size());
+    for (Index j = 0; j < taus.size(); ++j) {
+      const Complex z = std::polar(1.0, -taus(j)), z2 = z * z;
+      Complex phase = 1.0, factor = z;  // e^{-i m^2 tau}, e^{-i (2m+1) tau}
+      t.phases(0, j) = 1.0;
+      for (int m = 1; m <= n_x_ / 2; ++m) {
+        phase *= factor;
+        factor *= z2;
+        t.phases(m, j) = phase;
+      }
+    }
+    return t.phases;
+  }
+
+  struct PhaseTable {
+    tsi::RealVector taus;
+    tsi::Matrix phases;
+  };
+
+  int n_x_;
+  tsi::RealVector wave_numbers_;
+  mutable std::array<PhaseTable, 2> phase_tables_;
+  mutable size_t next_table_ = 0;
+  mutable std::mutex mutex_;  // the batches' buffers are shared work space
+  mutable std::map<Index, std::unique_ptr<XBatch>> batches_;
+};
+
+void register_nls(tsi::Registry& registry) {
+  tsi::ModelEntry entry;
+  entry.info.name = "nls";
+  entry.info.summary =
+      "cubic NLS i u_t = -(1/eps) u_xx + |u|^2 u on the torus (eq. NLS eq), Fourier in x, dim n_x";
+  entry.info.params = {
+      tsi::integer_param("n_x", 16, "Fourier modes (grid points) in x; u0 is given as samples on this grid")
+          .check(
+              [](const tsi::Json& v) {
+                return v.get<long>() >= 2 && v.get<long>() <= (1L << 20) && v.get<long>() % 2 == 0;
+              },
+              "an even integer in [2, 1048576]")};
+  entry.default_n_tau = 256;
+  entry.nonlinearity_degree = 3;
+  entry.create = [](const tsi::Params& p) {
+    return std::make_unique<Nls>(p.number("eps"), static_cast<int>(p.integer("n_x")));
+  };
+  registry.add_model(std::move(entry));
+}
+
+}  // namespace
+
+TSI_PLUGIN("nls", register_nls)
