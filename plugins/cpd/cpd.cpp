@@ -59,12 +59,12 @@ class ChargedParticle final : public tsi::Model {
     const double two_eps = 2.0 * eps();
     for (Index j = 0; j < u.cols(); ++j) {
       const Complex q1 = u(0, j), q2 = u(1, j);
-      Complex k;  // p' = k q
+      // p' = k q. The model is real: the imaginary parts on the tau grid are rounding, so
+      // the factor is computed in real arithmetic (no complex sqrt or division per point).
+      double k = -two_eps;
       if (potential_ == Potential::Coulomb) {
-        const Complex r2 = q1 * q1 + q2 * q2;
+        const double r2 = q1.real() * q1.real() + q2.real() * q2.real();
         k = two_eps / (r2 * std::sqrt(r2));
-      } else {
-        k = -two_eps;
       }
       out(0, j) = 0.0;
       out(1, j) = 0.0;
