@@ -1,6 +1,7 @@
 #pragma once
 // Builds models, reformulations and schemes from the shipped plugins, as the runner does,
 // for tests that drive the numerics directly.
+#include <algorithm>
 #include <map>
 #include <memory>
 #include <string>
@@ -46,6 +47,16 @@ class Harness {
   Registry registry_;
   PluginLoader loader_;
 };
+
+/// Every registered scheme that integrates the two-scale problem, by name.
+inline std::vector<const SchemeEntry*> two_scale_schemes() {
+  std::vector<const SchemeEntry*> out;
+  for (const auto* e : Harness::instance().registry().schemes()) {
+    const auto& r = e->traits.reformulations;
+    if (std::find(r.begin(), r.end(), "two-scale") != r.end()) out.push_back(e);
+  }
+  return out;
+}
 
 /// u(t_end) in physical variables: n steps of size t_end / n from the model's u0.
 inline Vector solve(const Model& model, Reformulation& reformulation, Stepper& stepper, double t_end, long n) {

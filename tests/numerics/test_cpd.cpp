@@ -251,34 +251,3 @@ TEST_CASE("cpd: the example cpd-se1.json runs and meets its reference") {
   CHECK(error > 1e-6);  // a real error of a second-order scheme at h = 1/8 ...
   CHECK(error < 1e-3);  // ... and a small one
 }
-
-TEST_CASE("cpd: a two-scale step with h then -h returns the state exactly when the scheme is symmetric") {
-  auto& h = Harness::instance();
-  for (const auto* scheme : h.registry().schemes()) {
-    if (!on_two_scale(*scheme)) continue;
-    // (At small eps the field is O(eps) and every scheme nearly returns: eps = 1 and 0.1.)
-    for (double eps : {1.0, 0.1}) {
-      auto model = h.model("cpd", eps);
-      auto two_scale = h.reformulation("two-scale", model, {{"n_tau", 64}, {"initial_data_order", 2}});
-      tsi::Json params = tsi::Json::object();
-      for (const auto& p : scheme->info.params) {
-        if (p.name == "tol") params["tol"] = 1e-15;
-        if (p.name == "max_iter") params["max_iter"] = 1000;
-      }
-      auto stepper = h.scheme(scheme->info.name, params);
-      const Vector start = two_scale->prepare(model->initial_value());
-      Vector y = start;
-      stepper->reset();
-      stepper->step(*two_scale, 0.0, 0.5, y);
-      stepper->step(*two_scale, 0.5, -0.5, y);
-      const double back = tsi::max_norm(y - start) / tsi::max_norm(start);
-      CAPTURE(scheme->info.name);
-      CAPTURE(eps);
-      CAPTURE(back);
-      if (scheme->traits.symmetric)
-        CHECK(back <= 1e-12);
-      else
-        CHECK(back > 1e-8);
-    }
-  }
-}

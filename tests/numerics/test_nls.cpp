@@ -331,34 +331,3 @@ TEST_CASE("nls: a user's u0 is read as samples on the x grid") {
   CHECK(wrong.exit_code == 2);
   CHECK(tsi::test::contains(wrong.err, "model.u0"));
 }
-
-TEST_CASE("nls: a two-scale step with h then -h returns the state exactly when the scheme is symmetric") {
-  auto& h = Harness::instance();
-  for (const auto* scheme : h.registry().schemes()) {
-    const auto& r = scheme->traits.reformulations;
-    if (std::find(r.begin(), r.end(), "two-scale") == r.end()) continue;
-    for (double eps : {1.0, 1e-3}) {
-      auto model = h.model("nls", eps);
-      auto two_scale = h.reformulation("two-scale", model, {{"n_tau", 256}, {"initial_data_order", 2}});
-      tsi::Json params = tsi::Json::object();
-      for (const auto& p : scheme->info.params) {
-        if (p.name == "tol") params["tol"] = 1e-15;
-        if (p.name == "max_iter") params["max_iter"] = 1000;
-      }
-      auto stepper = h.scheme(scheme->info.name, params);
-      const Vector start = two_scale->prepare(model->initial_value());
-      Vector y = start;
-      stepper->reset();
-      stepper->step(*two_scale, 0.0, 0.25, y);
-      stepper->step(*two_scale, 0.25, -0.25, y);
-      const double back = tsi::max_norm(y - start) / tsi::max_norm(start);
-      CAPTURE(scheme->info.name);
-      CAPTURE(eps);
-      CAPTURE(back);
-      if (scheme->traits.symmetric)
-        CHECK(back <= 1e-12);
-      else
-        CHECK(back > 1e-8);
-    }
-  }
-}
