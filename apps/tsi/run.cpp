@@ -33,8 +33,12 @@ Vector initial_value(const Model& model, const Json& model_config) {
     const Json& v = u0[static_cast<size_t>(i)];
     if (v.is_number())
       x(i) = v.get<double>();
-    else if (v.is_array() && v.size() == 2 && v[0].is_number() && v[1].is_number())
+    else if (v.is_array() && v.size() == 2 && v[0].is_number() && v[1].is_number()) {
+      if (!model.is_complex() && v[1].get<double>() != 0.0)
+        throw ConfigError(fmt::format("model.u0[{}]", i),
+                          "got " + v.dump() + ", expected a real number (this model's state is real)");
       x(i) = Complex(v[0].get<double>(), v[1].get<double>());
+    }
     else
       throw ConfigError(fmt::format("model.u0[{}]", i), "got " + v.dump() + ", expected a number or [re, im]");
   }

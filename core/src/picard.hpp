@@ -1,4 +1,7 @@
 #pragma once
+#include <algorithm>
+#include <cmath>
+
 #include "tsi/fixed_point.hpp"
 
 namespace tsi {
@@ -13,8 +16,14 @@ class PicardSolver final : public FixedPointSolver {
     next_.resize(x.size());
     for (int k = 1; k <= options().max_iter; ++k) {
       g(x, next_);
-      const double scale = max_norm(next_);
-      increment = max_distance(next_, x) / (scale > 0.0 ? scale : 1.0);
+      // max |next - x|^2 and max |next|^2 in one pass over the data.
+      double distance2 = 0.0, scale2 = 0.0;
+      for (Index i = 0; i < x.size(); ++i) {
+        distance2 = std::max(distance2, std::norm(next_(i) - x(i)));
+        scale2 = std::max(scale2, std::norm(next_(i)));
+      }
+      const double scale = std::sqrt(scale2);
+      increment = std::sqrt(distance2) / (scale > 0.0 ? scale : 1.0);
       x.swap(next_);
       if (increment <= options().tol) return k;
     }

@@ -42,10 +42,11 @@ class ChargedParticle final : public tsi::Model {
     const HalfAngles& table = half_angles(taus);
     for (Index j = 0; j < u.cols(); ++j) {
       const double c = table.cos(j), s = table.sin(j);
-      const Complex q1 = u(0, j), q2 = u(1, j), p1 = u(2, j), p2 = u(3, j);
+      // The model is real: compute with real parts (imaginary parts on the grid are rounding).
+      const double q1 = u(0, j).real(), q2 = u(1, j).real(), p1 = u(2, j).real(), p2 = u(3, j).real();
       // a = c q + s p, b = -s q + c p, then R applied to both.
-      const Complex a1 = c * q1 + s * p1, a2 = c * q2 + s * p2;
-      const Complex b1 = -s * q1 + c * p1, b2 = -s * q2 + c * p2;
+      const double a1 = c * q1 + s * p1, a2 = c * q2 + s * p2;
+      const double b1 = -s * q1 + c * p1, b2 = -s * q2 + c * p2;
       u(0, j) = c * a1 + s * a2;
       u(1, j) = -s * a1 + c * a2;
       u(2, j) = c * b1 + s * b2;
@@ -58,12 +59,12 @@ class ChargedParticle final : public tsi::Model {
   void nonlinear_field(ConstMatrixRef u, MatrixRef out) const override {
     const double two_eps = 2.0 * eps();
     for (Index j = 0; j < u.cols(); ++j) {
-      const Complex q1 = u(0, j), q2 = u(1, j);
+      const double q1 = u(0, j).real(), q2 = u(1, j).real();
       // p' = k q. The model is real: the imaginary parts on the tau grid are rounding, so
-      // the factor is computed in real arithmetic (no complex sqrt or division per point).
+      // everything is computed in real arithmetic (no complex sqrt or division per point).
       double k = -two_eps;
       if (potential_ == Potential::Coulomb) {
-        const double r2 = q1.real() * q1.real() + q2.real() * q2.real();
+        const double r2 = q1 * q1 + q2 * q2;
         k = two_eps / (r2 * std::sqrt(r2));
       }
       out(0, j) = 0.0;

@@ -306,3 +306,11 @@ TEST_CASE("run errors: an unknown command-line option is a usage error") {
 }
 
 }  // TEST_SUITE
+
+TEST_CASE("run errors: a complex u0 for a real model is bad input, never silently dropped") {
+  TempDir dir;
+  const CommandResult r = run_tsi({"run", example_config(), "--out", dir / "out", "--set",
+                                   "model.u0=[0.1, [0.1, 0.2], 0.1, 0.1]"});
+  CHECK(r.exit_code == 2);
+  CHECK(contains(r.err, "model.u0[1]: got [0.1,0.2], expected a real number"));
+}

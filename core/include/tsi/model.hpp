@@ -19,7 +19,9 @@ class TSI_API Model {
 
   /// Number of entries of u.
   virtual Index dim() const = 0;
-  /// True when u is genuinely complex; a real model keeps zero imaginary parts.
+  /// True when u is genuinely complex. A real model (false) is only ever given real states:
+  /// the imaginary parts it sees, e.g. on the tau grid after a transform, are rounding, and
+  /// its batched functions may compute with the real parts alone (half the work).
   virtual bool is_complex() const = 0;
 
   /// The exact linear flow e^{JM tau}, applied in place to column j with phase taus[j].
