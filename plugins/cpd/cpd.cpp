@@ -10,7 +10,6 @@
 // and e^{s K (x) I2} = [[cos s I2, sin s I2], [-sin s I2, cos s I2]]. With s = tau/2:
 //     e^{JM tau} = [[c R, s R], [-s R, c R]],   R = [[c, s], [-s, c]],   c = cos(tau/2), s = sin(tau/2).
 // Eigenvalues of JM: (+-i +- i)/2 = 0, 0, +i, -i; at tau = 2 pi, R = -I2 and c = -1: the identity.
-#include <array>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -18,6 +17,7 @@
 #include "tsi/error.hpp"
 #include "tsi/model.hpp"
 #include "tsi/plugin.hpp"
+#include "tsi/rotation_cache.hpp"
 
 namespace {
 
@@ -39,7 +39,7 @@ class ChargedParticle final : public tsi::Model {
   bool is_complex() const override { return false; }
 
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
-    const HalfAngles& table = half_angles(taus);
+    const auto& table = half_angles_.get(taus);
     for (Index j = 0; j < u.cols(); ++j) {
       const double c = table.cos(j), s = table.sin(j);
       // The model is real: compute with real parts (imaginary parts on the grid are rounding).
@@ -138,31 +138,13 @@ class ChargedParticle final : public tsi::Model {
   }
 
  private:
-  struct HalfAngles {
-    tsi::RealVector taus, cos, sin;  // cos(tau/2), sin(tau/2)
-  };
-
-  // The tables of the last two tau sets (the two-scale grid and its negative come back at
-  // every evaluation). Not thread-safe: a model instance serves one run.
-  const HalfAngles& half_angles(const tsi::RealVector& taus) const {
-    for (auto& t : tables_)
-      if (t.taus.size() == taus.size() && t.taus == taus) return t;
-    HalfAngles& t = tables_[next_table_];
-    next_table_ = (next_table_ + 1) % tables_.size();
-    t.taus = taus;
-    t.cos = (0.5 * taus.array()).cos();
-    t.sin = (0.5 * taus.array()).sin();
-    return t;
-  }
-
   double potential(double x1, double x2) const {
     const double r2 = x1 * x1 + x2 * x2;
     return potential_ == Potential::Coulomb ? 1.0 / std::sqrt(r2) : 0.5 * r2;
   }
 
   Potential potential_;
-  mutable std::array<HalfAngles, 2> tables_;
-  mutable size_t next_table_ = 0;
+  mutable tsi::RotationCache half_angles_{0.5};  // cos(tau/2), sin(tau/2) of the tau grid
 };
 
 void register_cpd(tsi::Registry& registry) {

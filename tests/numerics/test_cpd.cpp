@@ -41,11 +41,6 @@ Vector physical_rk4(double eps, double t_end, long n) {
 
 double relative(const Vector& x, const Vector& ref) { return (x - ref).norm() / ref.norm(); }
 
-bool on_two_scale(const tsi::SchemeEntry& e) {
-  const auto& r = e.traits.reformulations;
-  return std::find(r.begin(), r.end(), "two-scale") != r.end();
-}
-
 // FD's third-order data is rougher in tau: N_tau = 128 for it (SPEC.md section 4).
 int n_tau_for(const tsi::SchemeEntry& scheme) { return scheme.traits.initial_data_order >= 3 ? 128 : 64; }
 
@@ -171,8 +166,7 @@ TEST_CASE("cpd: the rk78 reference agrees with RK4 on the physical equations") {
 
 TEST_CASE("cpd: second order at eps = 1 for every two-scale scheme") {
   std::vector<std::string> names;
-  for (const auto* scheme : Harness::instance().registry().schemes()) {
-    if (!on_two_scale(*scheme)) continue;
+  for (const auto* scheme : tsi::test::two_scale_schemes()) {
     names.push_back(scheme->info.name);
     // The asymptotic range h = 1/16 .. 1/128. (From h = 1/4, FD and ME are still
     // pre-asymptotic at eps = 1: their successive orders rise 1.5, 1.8, 2.0 and
@@ -194,8 +188,7 @@ TEST_CASE("cpd: second order at eps = 1 for every two-scale scheme") {
 
 TEST_CASE("cpd: at every h the error of every two-scale scheme falls as eps falls") {
   // The dynamics become trivial at leading order as eps -> 0 (SPEC.md section 5.1).
-  for (const auto* scheme : Harness::instance().registry().schemes()) {
-    if (!on_two_scale(*scheme)) continue;
+  for (const auto* scheme : tsi::test::two_scale_schemes()) {
     for (long n : {4, 8, 16, 32}) {
       const double e1 = cpd_error(*scheme, 1.0, n), e16 = cpd_error(*scheme, 1.0 / 16, n),
                    e256 = cpd_error(*scheme, 1.0 / 256, n);

@@ -10,7 +10,6 @@ namespace {
 
 namespace t = tsi::test;
 
-bool mentions(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 }  // namespace
 
@@ -23,8 +22,8 @@ TEST_CASE("check: a shipped model passes with a shipped scheme") {
   for (const char* part : {"henon-heiles (provided by", "linear_flow(2 pi) u = u", "batched calls",
                            "real states stay real", "energy H conserved at eps = 0.001", "se1", "symmetry",
                            "henon-heiles: all"})
-    CHECK_MESSAGE(mentions(r.out, part), "missing: " << part);
-  CHECK_FALSE(mentions(r.out, "FAIL"));
+    CHECK_MESSAGE(t::contains(r.out, part), "missing: " << part);
+  CHECK_FALSE(t::contains(r.out, "FAIL"));
 }
 
 TEST_CASE("check: a model with a wrong linear flow fails and says why") {
@@ -33,14 +32,14 @@ TEST_CASE("check: a model with a wrong linear flow fails and says why") {
   INFO(r.describe());
   CHECK(r.signal == 0);
   CHECK(r.exit_code == 1);
-  CHECK(mentions(r.out, "fixture-broken-flow (provided by"));
-  CHECK(mentions(r.out, "tsi_fixture_broken_flow.so"));
-  CHECK(mentions(r.out, "checks FAILED"));
-  CHECK(mentions(r.out, "linear_flow(2 pi) u = u: "));
-  CHECK(mentions(r.out, "2 pi periodic"));
-  CHECK(mentions(r.out, "d/dtau linear_flow(tau) u at 0 = J M u: "));
-  CHECK(mentions(r.out, "energy H conserved at eps = 1: "));
-  CHECK_FALSE(mentions(r.out, "henon-heiles"));  // only the plugin's model is checked
+  CHECK(t::contains(r.out, "fixture-broken-flow (provided by"));
+  CHECK(t::contains(r.out, "tsi_fixture_broken_flow.so"));
+  CHECK(t::contains(r.out, "checks FAILED"));
+  CHECK(t::contains(r.out, "linear_flow(2 pi) u = u: "));
+  CHECK(t::contains(r.out, "2 pi periodic"));
+  CHECK(t::contains(r.out, "d/dtau linear_flow(tau) u at 0 = J M u: "));
+  CHECK(t::contains(r.out, "energy H conserved at eps = 1: "));
+  CHECK_FALSE(t::contains(r.out, "henon-heiles"));  // only the plugin's model is checked
 }
 
 TEST_CASE("check: the runner's --plugin selects the plugin's model too") {
@@ -48,8 +47,8 @@ TEST_CASE("check: the runner's --plugin selects the plugin's model too") {
       t::run_tsi({"--plugin", t::fixture_plugin("broken_flow"), "check", "--scheme", "se1", "--eps", "0.5"});
   INFO(r.describe());
   CHECK(r.exit_code == 1);
-  CHECK(mentions(r.out, "fixture-broken-flow"));
-  CHECK(mentions(r.out, "eps = 0.5"));
+  CHECK(t::contains(r.out, "fixture-broken-flow"));
+  CHECK(t::contains(r.out, "eps = 0.5"));
 }
 
 TEST_CASE("check: bad input is exit code 2 with a message") {
@@ -57,20 +56,20 @@ TEST_CASE("check: bad input is exit code 2 with a message") {
     const t::CommandResult r = t::run_tsi({"check", "no-such-model"});
     INFO(r.describe());
     CHECK(r.exit_code == 2);
-    CHECK(mentions(r.err, "\"no-such-model\""));
-    CHECK(mentions(r.err, "henon-heiles"));  // the valid names
+    CHECK(t::contains(r.err, "\"no-such-model\""));
+    CHECK(t::contains(r.err, "henon-heiles"));  // the valid names
   }
   SUBCASE("eps out of range") {
     const t::CommandResult r = t::run_tsi({"check", "henon-heiles", "--eps", "2"});
     INFO(r.describe());
     CHECK(r.exit_code == 2);
-    CHECK(mentions(r.err, "check --eps: got 2, expected a number in (0, 1]"));
+    CHECK(t::contains(r.err, "check --eps: got 2, expected a number in (0, 1]"));
   }
   SUBCASE("a scheme that does not integrate the two-scale problem") {
     const t::CommandResult r = t::run_tsi({"check", "henon-heiles", "--scheme", "rk78"});
     INFO(r.describe());
     CHECK(r.exit_code == 2);
-    CHECK(mentions(r.err, "does not integrate the two-scale problem"));
+    CHECK(t::contains(r.err, "does not integrate the two-scale problem"));
   }
 }
 

@@ -5,15 +5,18 @@
 
 namespace tsi {
 
-/// cos and sin of a set of phases, recomputed only when the phases change. The linear flows
-/// of the models are rotations applied to the same tau grid (and its negative) at every
-/// evaluation, so two entries remove all trigonometry from a step. Not thread-safe: a model
-/// instance serves one run.
+/// cos(w tau) and sin(w tau) of a set of phases tau, recomputed only when the phases change.
+/// The linear flows of the models are rotations applied to the same tau grid (and its
+/// negative) at every evaluation, so two entries remove all trigonometry from a step.
+/// Not thread-safe: a model instance serves one run.
 class RotationCache {
  public:
   struct Table {
     RealVector taus, cos, sin;
   };
+
+  /// w, the frequency of the rotations (the charged particle's flow turns by tau / 2).
+  explicit RotationCache(double frequency = 1.0) : frequency_(frequency) {}
 
   /// The table for `taus`, from the cache when the same phases were seen last or before.
   const Table& get(const RealVector& taus) {
@@ -22,12 +25,13 @@ class RotationCache {
     Table& t = tables_[next_];
     next_ = (next_ + 1) % tables_.size();
     t.taus = taus;
-    t.cos = taus.array().cos();
-    t.sin = taus.array().sin();
+    t.cos = (frequency_ * taus.array()).cos();
+    t.sin = (frequency_ * taus.array()).sin();
     return t;
   }
 
  private:
+  double frequency_;
   std::array<Table, 2> tables_;
   size_t next_ = 0;
 };

@@ -22,9 +22,4 @@ inline double inner(const Vector& u, const Vector& v) { return u.dot(v).real(); 
 /// so there is one square root, not one hypot per entry.
 inline double max_norm(const Vector& v) { return v.size() ? std::sqrt(v.cwiseAbs2().maxCoeff()) : 0.0; }
 
-/// max |a_i - b_i| without forming a temporary or a hypot per entry.
-inline double max_distance(const Vector& a, const Vector& b) {
-  return a.size() ? std::sqrt((a - b).cwiseAbs2().maxCoeff()) : 0.0;
-}
-
 }  // namespace tsi
