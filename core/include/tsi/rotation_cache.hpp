@@ -1,5 +1,6 @@
 #pragma once
 #include <array>
+#include <cstring>
 
 #include "tsi/types.hpp"
 
@@ -20,8 +21,10 @@ class RotationCache {
 
   /// The table for `taus`, from the cache when the same phases were seen last or before.
   const Table& get(const RealVector& taus) {
+    // Bitwise comparison (memcmp is vectorised; an element-wise == loop was 15% of a flow).
+    const size_t bytes = static_cast<size_t>(taus.size()) * sizeof(double);
     for (auto& t : tables_)
-      if (t.taus.size() == taus.size() && t.taus == taus) return t;
+      if (t.taus.size() == taus.size() && std::memcmp(t.taus.data(), taus.data(), bytes) == 0) return t;
     Table& t = tables_[next_];
     next_ = (next_ + 1) % tables_.size();
     t.taus = taus;
