@@ -60,7 +60,8 @@ const ParamSchema& reference_schema() {
           .range(0.0, std::numeric_limits<double>::infinity(), true),
       bool_param("estimate_accuracy", true,
                  "estimate the reference's own error by a second run at tol / 10 and twice the "
-                 "substeps per fast period")};
+                 "substeps per fast period (at least what rounding its state in model variables "
+                 "causes)")};
   return schema;
 }
 

@@ -1,34 +1,82 @@
 #include "direct.hpp"
 
-namespace tsi {
+#include <fmt/format.h>
 
-Direct::Direct(std::shared_ptr<const Model> model)
+#include <cmath>
+
+#include "tsi/error.hpp"
+
+namespace tsi {
+namespace {
+
+// T(a + 2b) against T(a) + 2 T(b) for two states of the model's kind: a linear T agrees to
+// rounding, an affine or nonlinear one does not.
+void require_linear_to_physical(const Model& model) {
+  const Vector a = model.initial_value();
+  Vector b(a.size());
+  for (Index i = 0; i < a.size(); ++i) {
+    const double w = 0.3 + 0.7 * static_cast<double>(i + 1) / static_cast<double>(a.size());
+    b(i) = model.is_complex() ? Complex(w, 0.5 * w) : Complex(w, 0.0);
+  }
+  const Vector lhs = model.to_physical(a + 2.0 * b);
+  const Vector rhs = model.to_physical(a) + 2.0 * model.to_physical(b);
+  const double scale = std::max(max_norm(lhs), max_norm(rhs));
+  if (!(max_norm(lhs - rhs) <= 1e-10 * std::max(scale, 1.0)))
+    throw ConfigError("reformulation.variables",
+                      fmt::format("got \"physical\", but the model maps to physical variables non-linearly "
+                                  "(T(a + 2b) - T(a) - 2 T(b) = {:.3e}); expected \"model\"",
+                                  max_norm(lhs - rhs)));
+}
+
+}  // namespace
+
+Direct::Direct(std::shared_ptr<const Model> model, Variables variables)
     : Reformulation(std::move(model)),
+      physical_(variables == Variables::physical),
+      size_(model_->dim()),
       state_(model_->dim(), 1),
       direction_(model_->dim(), 1),
       field_(model_->dim(), 1),
       mu_(model_->dim()),
-      jmu_(model_->dim()) {}
+      jmu_(model_->dim()) {
+  if (physical_) {
+    require_linear_to_physical(*model_);
+    size_ = model_->to_physical(model_->initial_value()).size();
+  }
+}
 
-void Direct::nonlinear(double /*t*/, const Vector& y, Vector& out) {
-  ++evaluations_;
-  state_.col(0) = y;
+void Direct::model_nonlinear(const Vector& u, Vector& out) {
+  state_.col(0) = u;
   model_->nonlinear_field(state_, field_);
   out = field_.col(0);
 }
 
-void Direct::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& dy, Vector& out) {
-  state_.col(0) = y;
-  direction_.col(0) = dy;
-  model_->nonlinear_field_derivative(state_, direction_, field_);
-  out = field_.col(0);
-}
-
-void Direct::rhs(double t, const Vector& y, Vector& out) {
-  nonlinear(t, y, out);
-  model_->apply_M(y, mu_);
+void Direct::model_rhs(const Vector& u, Vector& out) {
+  model_nonlinear(u, out);
+  model_->apply_M(u, mu_);
   model_->apply_J(mu_, jmu_);
   out += jmu_ / model_->eps();
+}
+
+void Direct::nonlinear(double /*t*/, const Vector& y, Vector& out) {
+  ++evaluations_;
+  if (!physical_) return model_nonlinear(y, out);
+  model_nonlinear(model_->from_physical(y), out);
+  out = model_->to_physical(out);
+}
+
+void Direct::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& dy, Vector& out) {
+  state_.col(0) = physical_ ? model_->from_physical(y) : y;
+  direction_.col(0) = physical_ ? model_->from_physical(dy) : dy;
+  model_->nonlinear_field_derivative(state_, direction_, field_);
+  out = physical_ ? model_->to_physical(field_.col(0)) : Vector(field_.col(0));
+}
+
+void Direct::rhs(double /*t*/, const Vector& y, Vector& out) {
+  ++evaluations_;
+  if (!physical_) return model_rhs(y, out);
+  model_rhs(model_->from_physical(y), out);
+  out = model_->to_physical(out);
 }
 
 }  // namespace tsi

@@ -6,11 +6,18 @@ namespace tsi {
 
 /// The model as it stands: y = u, y' = (1/eps) JM y + J grad H1(y). L is not diagonal in
 /// these coordinates, so only schemes that use rhs() (classical solvers) apply.
+///
+/// With Variables::physical the state is x = T u, T = the model's to_physical, and
+/// x' = T F(T^{-1} x): the problem as a user would integrate it in the variables errors are
+/// measured in. This matters when T is ill-conditioned in eps (the charged particle's
+/// v = (p + B q) / (2 eps)): a tolerance on u is then a tolerance 1/eps larger on x.
+/// T must be linear; the constructor checks it.
 class Direct final : public Reformulation {
  public:
-  explicit Direct(std::shared_ptr<const Model> model);
+  enum class Variables { model, physical };
+  explicit Direct(std::shared_ptr<const Model> model, Variables variables = Variables::model);
 
-  Index size() const override { return model_->dim(); }
+  Index size() const override { return size_; }
   const Vector& linear_multipliers() const override { return none_; }
   bool autonomous() const override { return true; }
   void nonlinear(double t, const Vector& y, Vector& out) override;
@@ -18,7 +25,7 @@ class Direct final : public Reformulation {
   void rhs(double t, const Vector& y, Vector& out) override;
 
   /// Exact flows when the model has an exact nonlinear flow: e^{hL} = e^{JM h/eps}.
-  bool has_exact_flows() const override { return model_->has_exact_nonlinear_flow(); }
+  bool has_exact_flows() const override { return !physical_ && model_->has_exact_nonlinear_flow(); }
   void linear_flow(double h, Vector& y) override { y = model_->linear_flow(fast_phase(h, model_->eps()), y); }
   /// One exact nonlinear flow counts as one evaluation of N (the work measure of splitting).
   void nonlinear_flow(double /*t*/, double h, Vector& y) override {
@@ -26,10 +33,15 @@ class Direct final : public Reformulation {
     model_->nonlinear_flow(h, y);
   }
 
-  Vector prepare(const Vector& u0) override { return u0; }
-  Vector read_back(const Vector& y, double /*t*/) override { return y; }
+  Vector prepare(const Vector& u0) override { return physical_ ? model_->to_physical(u0) : u0; }
+  Vector read_back(const Vector& y, double /*t*/) override { return physical_ ? model_->from_physical(y) : y; }
 
  private:
+  void model_nonlinear(const Vector& u, Vector& out);
+  void model_rhs(const Vector& u, Vector& out);
+
+  bool physical_;
+  Index size_;
   Vector none_;
   Matrix state_, direction_, field_;
   Vector mu_, jmu_;

@@ -47,9 +47,13 @@ void register_core(Registry& registry) {
 
   ReformulationEntry direct;
   direct.info = {"direct", {}, "u' = J[(1/eps) M u + grad H1(u)] as it stands (classical solvers)",
-                 {}, ""};
-  direct.create = [](std::shared_ptr<const Model> model, const Params&) {
-    return std::make_unique<Direct>(std::move(model));
+                 {string_param("variables", "model",
+                               "the variables integrated: u (model), or those errors are measured in (physical)")
+                      .choices({"model", "physical"})},
+                 ""};
+  direct.create = [](std::shared_ptr<const Model> model, const Params& p) {
+    const bool physical = p.has("variables") && p.string("variables") == "physical";
+    return std::make_unique<Direct>(std::move(model), physical ? Direct::Variables::physical : Direct::Variables::model);
   };
   registry.add_reformulation(std::move(direct));
 
