@@ -67,5 +67,19 @@ TEST_CASE("work to reach an error interpolates between the bracketing runs") {
   const tsi::Json w = tsi::app::work_at_error(rows, {1e-4, 1e-12});
   REQUIRE(w.size() == 1);
   CHECK(w[0]["seconds"][0].get<double>() == doctest::Approx(1e-2).epsilon(1e-9));
-  CHECK(w[0]["seconds"][1].is_null());  // not bracketed
+  CHECK(w[0]["how"][0] == "interpolated");
+  CHECK(w[0]["seconds"][1].is_null());  // no run reaches it
+  CHECK(w[0]["how"][1].is_null());
+}
+
+TEST_CASE("work to reach an error every run beats is the cheapest run's, marked as a bound") {
+  tsi::Json rows = tsi::Json::array();
+  // Errors 1e-9 .. 1e-11 (all below 1e-6); wall (= h here) 3e-3, 1e-3 (the cheapest), 2e-3.
+  rows.push_back(row("r", 1.0, 3e-3, 1e-9));
+  rows.push_back(row("r", 1.0, 1e-3, 1e-10));
+  rows.push_back(row("r", 1.0, 2e-3, 1e-11));
+  const tsi::Json w = tsi::app::work_at_error(rows, {1e-6});
+  REQUIRE(w.size() == 1);
+  CHECK(w[0]["seconds"][0].get<double>() == 1e-3);
+  CHECK(w[0]["how"][0] == "at_most");
 }
