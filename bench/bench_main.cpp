@@ -1,7 +1,8 @@
 // What a two-scale step costs, per model at the paper's sizes, against the FFTs it must do:
 //   nonlinearity/<model>   one evaluation of f_tau over the whole tau grid (one sweep's work)
 //   fft_bound/<model>      the transforms alone that one evaluation needs (back and forth)
-//   step/<model>/<scheme>  one step at h = 1/8, eps = 0.01 (counter: fixed-point sweeps)
+//   step/<model>/<scheme>  one step at h = 1/8, eps = 0.01 (counters: fixed-point sweeps and
+//                          evaluations of N per step)
 //   step_eps/<model>/se1/<eps>  the same at eps = 1 and 1e-6: the cost must not depend on eps
 // Models and schemes come from the registry, so a new plugin is benchmarked without edits.
 #include <benchmark/benchmark.h>
@@ -99,6 +100,8 @@ void step(benchmark::State& state, Case c, std::string scheme, double eps) {
   }
   const auto stats = stepper->stats();
   state.counters["sweeps"] = stats.solves ? stats.iterations_mean() : 0.0;
+  // Evaluations of N per step (SE2: one per quadrature node and sweep): the FFT work a step must do.
+  state.counters["evaluations"] = static_cast<double>(problem->evaluations()) / static_cast<double>(state.iterations());
 }
 
 std::vector<Case> paper_cases() {

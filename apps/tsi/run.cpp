@@ -60,7 +60,14 @@ Vector reference_model_state(const Json& config, const Registry& registry, doubl
     if (spec.name == "substeps_per_period")
       scheme_params["substeps_per_period"] = spec.default_value.get<double>() * substep_factor;
   }
-  auto reformulation = reform.create(model, Params(resolve_params(reform.info.params, Json::object(), "reference")));
+  // A two-scale reference gets the model's own tau resolution and the data its scheme needs.
+  Json reform_params = Json::object();
+  for (const auto& spec : reform.info.params) {
+    if (spec.name == "n_tau") reform_params["n_tau"] = registry.model(config["model"]["name"]).default_n_tau;
+    if (spec.name == "initial_data_order")
+      reform_params["initial_data_order"] = std::max(1, scheme.traits.initial_data_order);
+  }
+  auto reformulation = reform.create(model, Params(resolve_params(reform.info.params, reform_params, "reference")));
   auto stepper = scheme.create(Params(resolve_params(scheme.info.params, scheme_params, "reference")));
   const double t_end = config["time"]["t_end"];
   Vector y = reformulation->prepare(initial_value(*model, config["model"]));
