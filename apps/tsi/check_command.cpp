@@ -181,6 +181,21 @@ void ModelChecks::interface(double eps) {
                       relative(field.col(j), f1.col(0), std::max(max_norm(f1.col(0)), scale)),
                       relative(dfield.col(j), d1.col(0), std::max(max_norm(d1.col(0)), scale))});
   }
+  // filtered_field against its definition (a model may fuse the three steps).
+  Matrix scratch = states, fused(n, 3), composed = states, field_back(n, 3);
+  const RealVector minus_taus = -taus;
+  mod.filtered_field(taus, minus_taus, scratch, fused);
+  mod.linear_flow(taus, composed);
+  mod.nonlinear_field(composed, field_back);
+  mod.linear_flow(minus_taus, field_back);
+  double fused_error = 0.0;
+  for (Index j = 0; j < 3; ++j)
+    fused_error = std::max(fused_error, relative(fused.col(j), field_back.col(j),
+                                                 std::max(max_norm(field_back.col(j)), 1e-300)));
+  check("filtered_field = flow, field, flow back", fused_error, 1e-12,
+        "filtered_field(taus, -taus, u) must equal linear_flow(-tau) of nonlinear_field of linear_flow(tau) u, "
+        "column by column");
+
   check("batched calls = one column at a time", batch, 1e-12,
         "batched calls take one state per column (column j: the state at the j-th tau point); "
         "every column must be treated, independently of the others");

@@ -8,6 +8,7 @@ Filtered::Filtered(std::shared_ptr<const Model> model)
     : Reformulation(std::move(model)),
       zeros_(Vector::Zero(model_->dim())),
       tau_(1),
+      minus_tau_(1),
       state_(model_->dim(), 1),
       direction_(model_->dim(), 1),
       field_(model_->dim(), 1) {}
@@ -15,11 +16,9 @@ Filtered::Filtered(std::shared_ptr<const Model> model)
 void Filtered::nonlinear(double t, const Vector& y, Vector& out) {
   ++evaluations_;
   tau_(0) = fast_phase(t, model_->eps());
+  minus_tau_(0) = -tau_(0);
   state_.col(0) = y;
-  model_->linear_flow(tau_, state_);
-  model_->nonlinear_field(state_, field_);
-  tau_(0) = -tau_(0);
-  model_->linear_flow(tau_, field_);
+  model_->filtered_field(tau_, minus_tau_, state_, field_);
   out = field_.col(0);
 }
 

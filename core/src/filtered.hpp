@@ -25,7 +25,7 @@ class Filtered final : public Reformulation {
 
  private:
   Vector zeros_;
-  RealVector tau_;  // one phase, reused
+  RealVector tau_, minus_tau_;  // one phase and its negative, reused
   Matrix state_, direction_, field_;
 };
 

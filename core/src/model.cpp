@@ -35,6 +35,13 @@ void Model::nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef dir
   }
 }
 
+void Model::filtered_field(const RealVector& taus, const RealVector& minus_taus, MatrixRef states,
+                           MatrixRef out) const {
+  linear_flow(taus, states);
+  nonlinear_field(states, out);
+  linear_flow(minus_taus, out);
+}
+
 void Model::nonlinear_flow(double /*t*/, Vector& /*u*/) const {
   throw Error("this model has no exact nonlinear flow (has_exact_nonlinear_flow() is false)");
 }

@@ -41,9 +41,7 @@ void TwoScale::nonlinear(double /*t*/, const Vector& y, Vector& out) {
   auto field = field_fft_.data();
   grid = Eigen::Map<const Matrix>(y.data(), dim_, n_tau_);
   fft_.backward();
-  model_->linear_flow(taus_, grid);
-  model_->nonlinear_field(grid, field);
-  model_->linear_flow(minus_taus_, field);
+  model_->filtered_field(taus_, minus_taus_, grid, field);
   field_fft_.forward_unnormalised();
   out.resize(size());
   Eigen::Map<Matrix>(out.data(), dim_, n_tau_) = field * (1.0 / n_tau_);  // the 1/n of the transform
@@ -70,10 +68,8 @@ Matrix TwoScale::to_grid(const Matrix& c) {
 
 Matrix TwoScale::f_coefficients(const Matrix& grid) {
   Matrix w = grid;
-  model_->linear_flow(taus_, w);
   Matrix f(dim_, n_tau_);
-  model_->nonlinear_field(w, f);
-  model_->linear_flow(minus_taus_, f);
+  model_->filtered_field(taus_, minus_taus_, w, f);
   auto buffer = fft_.data();
   buffer = f;
   fft_.forward();

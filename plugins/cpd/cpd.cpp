@@ -10,6 +10,7 @@
 // and e^{s K (x) I2} = [[cos s I2, sin s I2], [-sin s I2, cos s I2]]. With s = tau/2:
 //     e^{JM tau} = [[c R, s R], [-s R, c R]],   R = [[c, s], [-s, c]],   c = cos(tau/2), s = sin(tau/2).
 // Eigenvalues of JM: (+-i +- i)/2 = 0, 0, +i, -i; at tau = 2 pi, R = -I2 and c = -1: the identity.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -71,6 +72,48 @@ class ChargedParticle final : public tsi::Model {
       out(1, j) = 0.0;
       out(2, j) = k * q1;
       out(3, j) = k * q2;
+    }
+  }
+
+  // The three steps of f_tau in one pass: only the rotated q enters the field, and the field
+  // (0, 0, k q) turns back by -tau. In blocks of columns, so that the Coulomb factor (a square
+  // root and a division per point, the bulk of the work) runs over contiguous arrays the
+  // compiler vectorises.
+  void filtered_field(const tsi::RealVector& taus, const tsi::RealVector& /*minus_taus*/, MatrixRef u,
+                      MatrixRef out) const override {
+    const auto& table = half_angles_.get(taus);
+    const double two_eps = 2.0 * eps();
+    constexpr Index block = 16;
+    double x1[block], x2[block], k[block];
+    for (Index j0 = 0; j0 < u.cols(); j0 += block) {
+      const Index m = std::min(block, u.cols() - j0);
+      for (Index i = 0; i < m; ++i) {
+        const Index j = j0 + i;
+        const double c = table.cos(j), s = table.sin(j);
+        const double q1 = u(0, j).real(), q2 = u(1, j).real(), p1 = u(2, j).real(), p2 = u(3, j).real();
+        const double a1 = c * q1 + s * p1, a2 = c * q2 + s * p2;
+        x1[i] = c * a1 + s * a2;  // q of e^{JM tau} u
+        x2[i] = -s * a1 + c * a2;
+      }
+      if (potential_ == Potential::Coulomb) {
+        for (Index i = 0; i < m; ++i) {
+          const double r2 = x1[i] * x1[i] + x2[i] * x2[i];
+          k[i] = two_eps / (r2 * std::sqrt(r2));
+        }
+      } else {
+        for (Index i = 0; i < m; ++i) k[i] = -two_eps;
+      }
+      for (Index i = 0; i < m; ++i) {
+        const Index j = j0 + i;
+        const double c = table.cos(j), s = table.sin(j);
+        const double f1 = k[i] * x1[i], f2 = k[i] * x2[i];
+        // linear_flow at -tau (sin -> -sin) applied to (0, 0, f1, f2).
+        const double b1 = -s * f1, b2 = -s * f2, d1 = c * f1, d2 = c * f2;
+        out(0, j) = c * b1 - s * b2;
+        out(1, j) = s * b1 + c * b2;
+        out(2, j) = c * d1 - s * d2;
+        out(3, j) = s * d1 + c * d2;
+      }
     }
   }
 

@@ -47,6 +47,22 @@ class HenonHeiles final : public tsi::Model {
     }
   }
 
+  // The three steps of f_tau in one pass: the flow turns (q1, p1) only, so the field needs
+  // the turned q1, and its (q1, p1) part, (0, -2 q1 q2), turns back by -tau.
+  void filtered_field(const tsi::RealVector& taus, const tsi::RealVector& /*minus_taus*/, MatrixRef u,
+                      MatrixRef out) const override {
+    const auto& table = rotations_.get(taus);
+    for (Index j = 0; j < u.cols(); ++j) {
+      const double c = table.cos(j), s = table.sin(j);
+      const double q1 = c * u(0, j).real() + s * u(2, j).real(), q2 = u(1, j).real(), p2 = u(3, j).real();
+      const double g = -2.0 * q1 * q2;
+      out(0, j) = -s * g;
+      out(1, j) = p2;
+      out(2, j) = c * g;
+      out(3, j) = -q2 - q1 * q1 + q2 * q2;
+    }
+  }
+
   void nonlinear_field_derivative(ConstMatrixRef u, ConstMatrixRef z, MatrixRef out) const override {
     for (Index j = 0; j < u.cols(); ++j) {
       const Complex q1 = u(0, j), q2 = u(1, j);

@@ -96,6 +96,41 @@ class Nls final : public tsi::Model {
     out = w.transpose();
   }
 
+  // f_tau in one pass each way: the phases e^{-i m^2 tau} are applied while the states are
+  // copied (transposed) into the x-batch, and their conjugates (the flow at -tau) while the
+  // result is copied out; the cubic term is written out in real arithmetic (-i a w = (a im, -a re)).
+  void filtered_field(const tsi::RealVector& taus, const tsi::RealVector& /*minus_taus*/, MatrixRef c,
+                      MatrixRef out) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const tsi::Matrix& phase = phases(taus);
+    XBatch& b = batch(c.cols());
+    auto w = b.data();  // row j: state j
+    const int half = n_x_ / 2;
+    for (Index j = 0; j < c.cols(); ++j) {
+      w(j, 0) = c(0, j);
+      for (int m = 1; m <= half; ++m) {
+        w(j, m) = times(c(m, j), phase(m, j));
+        if (n_x_ - m != m) w(j, n_x_ - m) = times(c(n_x_ - m, j), phase(m, j));
+      }
+    }
+    b.backward();
+    const double scale = 1.0 / (tsi::two_pi * n_x_);
+    double* p = reinterpret_cast<double*>(w.data());
+    for (Index i = 0; i < 2 * w.size(); i += 2) {
+      const double re = p[i], im = p[i + 1], a = scale * (re * re + im * im);
+      p[i] = a * im;
+      p[i + 1] = -a * re;
+    }
+    b.forward();
+    for (Index j = 0; j < c.cols(); ++j) {
+      out(0, j) = w(j, 0);
+      for (int m = 1; m <= half; ++m) {
+        out(m, j) = times_conj(w(j, m), phase(m, j));
+        if (n_x_ - m != m) out(n_x_ - m, j) = times_conj(w(j, n_x_ - m), phase(m, j));
+      }
+    }
+  }
+
   // D(-i |u|^2 u) z = -i (2 |u|^2 z + u^2 conj(z)), on the grid, same scaling as above.
   void nonlinear_field_derivative(ConstMatrixRef c, ConstMatrixRef dc, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -220,6 +255,14 @@ class Nls final : public tsi::Model {
       }
     }
     return t.phases;
+  }
+
+  // a b and a conj(b), written out: std::complex's operator* tests every product for inf/NaN.
+  static Complex times(Complex a, Complex b) {
+    return {a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real()};
+  }
+  static Complex times_conj(Complex a, Complex b) {
+    return {a.real() * b.real() + a.imag() * b.imag(), a.imag() * b.real() - a.real() * b.imag()};
   }
 
   struct PhaseTable {

@@ -91,7 +91,7 @@ TEST_CASE("loader: the layout handshake covers the exchanged structures") {
   CHECK(layout.entry_info.size == sizeof(tsi::EntryInfo));
   CHECK(layout.entry_info.align == alignof(tsi::EntryInfo));
   CHECK(layout.eigen_max_align_bytes == EIGEN_MAX_ALIGN_BYTES);
-  CHECK(TSI_PLUGIN_ABI_VERSION == 2);
+  CHECK(TSI_PLUGIN_ABI_VERSION == 3);  // 3: Model::filtered_field
 }
 
 TEST_CASE("loader: a plugin for another tsi major version is refused") {
@@ -136,7 +136,7 @@ TEST_CASE("loader: a directory scan collects failures without throwing") {
   // Sorted: duplicate loads before good into the empty registry, so good clashes with it;
   // shipped_duplicate's "henon-heiles" is free here (no shipped plugins in this registry).
   const std::vector<std::pair<const char*, bool>> expected = {
-      {"broken_flow", true}, {"duplicate", true},         {"good", false},
+      {"broken_flow", true}, {"broken_fused", true},      {"duplicate", true},        {"good", false},
       {"no_entry", false},   {"shipped_duplicate", true}, {"throws", false},
       {"wrong_abi", false},  {"wrong_layout", false},     {"wrong_major", false}};
   REQUIRE(reports.size() == expected.size());
@@ -146,8 +146,8 @@ TEST_CASE("loader: a directory scan collects failures without throwing") {
     CHECK(reports[i].ok == expected[i].second);
     CHECK(reports[i].error.empty() == expected[i].second);
   }
-  CHECK(reports[2].error.find("already registered") != std::string::npos);
-  CHECK(reports[7].error.find("tsi::ModelEntry") != std::string::npos);
+  CHECK(reports[3].error.find("already registered") != std::string::npos);
+  CHECK(reports[8].error.find("tsi::ModelEntry") != std::string::npos);
   CHECK(r.scheme("fixture-duplicate-scheme").info.provider == fixture("duplicate"));
   CHECK(loader.reports().size() == reports.size());
 }

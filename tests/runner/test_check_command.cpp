@@ -42,6 +42,14 @@ TEST_CASE("check: a model with a wrong linear flow fails and says why") {
   CHECK_FALSE(t::contains(r.out, "henon-heiles"));  // only the plugin's model is checked
 }
 
+TEST_CASE("check: a model whose fused filtered_field disagrees with flow, field and flow back fails") {
+  const t::CommandResult r = t::run_tsi({"check", "--plugin", t::fixture_plugin("broken_fused"), "--scheme", "se1"});
+  INFO(r.describe());
+  CHECK(r.exit_code == 1);
+  CHECK(t::contains(r.out, "filtered_field = flow, field, flow back: "));
+  CHECK(t::contains(r.out, "ok    linear_flow(2 pi) u = u"));  // the flow itself is right
+}
+
 TEST_CASE("check: the runner's --plugin selects the plugin's model too") {
   const t::CommandResult r =
       t::run_tsi({"--plugin", t::fixture_plugin("broken_flow"), "check", "--scheme", "se1", "--eps", "0.5"});
