@@ -2,7 +2,7 @@
 """tsi's speed in one run: the cost of a step against its FFTs, and the eps-independent
 advantage over classical solvers, measured side by side on this machine.
 
-    python3 scripts/bench.py [--build build] [--out out/bench] [--quick]
+    python3 bench/bench.py [--build build] [--out out/bench] [--quick]
 
 1. Google Benchmark (build/bin/tsi_bench): per model, the nonlinearity over the whole tau
    grid against the FFTs it must do (the bound), and per scheme ns per step, sweeps per
