@@ -4,6 +4,7 @@
 //   step/<model>/<scheme>  one step at h = 1/8, eps = 0.01 (counters: fixed-point sweeps and
 //                          evaluations of N per step)
 //   step_eps/<model>/se1/<eps>  the same at eps = 1 and 1e-6: the cost must not depend on eps
+//   nonlinearity_threads/<model>/2  the nonlinearity with FFTW on two threads (large NLS grids)
 // Models and schemes come from the registry, so a new plugin is benchmarked without edits.
 #include <benchmark/benchmark.h>
 
@@ -57,6 +58,13 @@ void nonlinearity(benchmark::State& state, Case c) {
     benchmark::DoNotOptimize(out.data());
   }
   state.counters["unknowns"] = static_cast<double>(y.size());
+}
+
+// The same with FFTW splitting each large batch over `threads` threads (set_fft_threads).
+void nonlinearity_threads(benchmark::State& state, Case c, int threads) {
+  tsi::set_fft_threads(threads);
+  nonlinearity(state, c);
+  tsi::set_fft_threads(1);
 }
 
 void fft_bound(benchmark::State& state, Case c) {
@@ -125,6 +133,9 @@ int main(int argc, char** argv) {
   for (const Case& c : paper_cases()) {
     benchmark::RegisterBenchmark(("nonlinearity/" + label(c)).c_str(), nonlinearity, c);
     benchmark::RegisterBenchmark(("fft_bound/" + label(c)).c_str(), fft_bound, c);
+    if (c.model_params.value("n_x", 16) != 16)  // large enough for FFTW's threads
+      benchmark::RegisterBenchmark(("nonlinearity_threads/" + label(c) + "/2").c_str(), nonlinearity_threads, c, 2)
+          ->UseRealTime();
     if (c.model_params.value("n_x", 16) != 16) continue;  // steps at the paper's sizes only
     for (const auto* s : registry().schemes()) {
       const auto& r = s->traits.reformulations;

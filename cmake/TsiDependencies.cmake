@@ -7,4 +7,6 @@ find_package(CLI11 REQUIRED)
 find_package(Boost 1.74 REQUIRED)          # header-only: Boost.Odeint
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
+# FFTW's thread support (libfftw3_threads, in the same Debian package) has no .pc file of its own.
+find_library(FFTW3_THREADS_LIBRARY NAMES fftw3_threads HINTS ${FFTW3_LIBRARY_DIRS} REQUIRED)
 find_package(Threads REQUIRED)

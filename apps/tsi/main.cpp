@@ -20,6 +20,7 @@
 #include "study_command.hpp"
 #include "summary.hpp"
 #include "tsi/error.hpp"
+#include "tsi/fft.hpp"
 #include "tsi/version.hpp"
 
 namespace {
@@ -61,6 +62,11 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", tsi::version_string);
   std::vector<std::string> plugin_files;
   app.add_option("--plugin", plugin_files, "load a plugin library (repeatable)")->check(CLI::ExistingFile);
+  int fft_threads = 1;
+  app.add_option("--fft-threads", fft_threads,
+                 "threads for each FFT batch of at least 65536 values (NLS from n_x = 256 with n_tau = 256; "
+                 "measured 1.2x faster on 2 cores there, slower on smaller grids); default 1")
+      ->check(CLI::PositiveNumber);
 
   auto* list = app.add_subcommand("list", "list registered models, reformulations and schemes");
   std::string what;
@@ -105,6 +111,7 @@ int main(int argc, char** argv) {
   }
 
   try {
+    tsi::set_fft_threads(fft_threads, 65536);
     tsi::Registry& registry = tsi::Registry::global();
     tsi::PluginLoader loader(registry);
     for (const auto& warning : tsi::app::load_plugins(loader, registry, plugin_files))

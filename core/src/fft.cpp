@@ -2,7 +2,9 @@
 
 #include <fftw3.h>
 
+#include <atomic>
 #include <mutex>
+#include <string>
 
 #include "tsi/error.hpp"
 
@@ -10,11 +12,24 @@ namespace tsi {
 namespace {
 // FFTW's planner is not thread-safe; execution of distinct plans is.
 std::mutex planner_mutex;
+std::atomic<int> threads_setting{1};
+std::atomic<long> threads_min_values{65536};
 }  // namespace
+
+void set_fft_threads(int threads, long min_values) {
+  if (threads < 1) throw ConfigError("fft threads", "got " + std::to_string(threads) + ", expected at least 1");
+  threads_setting = threads;
+  threads_min_values = min_values;
+}
+
+int fft_threads() { return threads_setting; }
 
 FftBatch::FftBatch(int n, int howmany) : n_(n), howmany_(howmany) {
   if (n <= 0 || howmany <= 0) throw Error("FftBatch: sizes must be positive");
   std::lock_guard<std::mutex> lock(planner_mutex);
+  static const bool threads_ready = fftw_init_threads() != 0;
+  const long values = static_cast<long>(n) * howmany;
+  fftw_plan_with_nthreads(threads_ready && values >= threads_min_values ? threads_setting.load() : 1);
   buffer_ = reinterpret_cast<Complex*>(fftw_alloc_complex(static_cast<size_t>(n) * howmany));
   auto* raw = reinterpret_cast<fftw_complex*>(buffer_);
   // Transform along tau: n points with stride howmany, one transform per component.

@@ -22,8 +22,13 @@ class Harness {
   }
 
   std::shared_ptr<const Model> model(const std::string& name, double eps) const {
+    return model_with(name, eps, Json::object());
+  }
+  /// The model with parameters besides eps (NLS's n_x).
+  std::shared_ptr<const Model> model_with(const std::string& name, double eps, Json params) const {
     const auto& e = registry_.model(name);
-    return e.create(Params(resolve_params(e.info.params, {{"eps", eps}}, "model")));
+    params["eps"] = eps;
+    return e.create(Params(resolve_params(e.info.params, params, "model")));
   }
 
   std::unique_ptr<Reformulation> reformulation(const std::string& name, std::shared_ptr<const Model> m,

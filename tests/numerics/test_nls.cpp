@@ -12,6 +12,7 @@
 #include "runner/run_command.hpp"
 #include "tsi/convergence.hpp"
 #include "tsi/error.hpp"
+#include "tsi/fft.hpp"
 
 namespace {
 
@@ -330,4 +331,31 @@ TEST_CASE("nls: a user's u0 is read as samples on the x grid") {
       tsi::test::run_tsi({"run", tsi::test::write_config(dir, config, "c.json"), "--out", dir / "c"});
   CHECK(wrong.exit_code == 2);
   CHECK(tsi::test::contains(wrong.err, "model.u0"));
+}
+
+TEST_CASE("nls: FFTW on two threads gives the one-thread answer (set_fft_threads, tsi --fft-threads)") {
+  // Threads for every batch here (min_values 1), so that a small grid exercises them.
+  auto& h = Harness::instance();
+  const auto run = [&](int threads) {
+    tsi::set_fft_threads(threads, 1);
+    auto model = h.model_with("nls", 0.01, {{"n_x", 32}});
+    auto two_scale = h.reformulation("two-scale", model, {{"n_tau", 64}});
+    auto se1 = h.scheme("se1");
+    const Vector x = tsi::test::solve(*model, *two_scale, *se1, 0.5, 4);
+    tsi::set_fft_threads(1);
+    return x;
+  };
+  const Vector one = run(1), two = run(2);
+  const double difference = (one - two).norm() / one.norm();
+  CAPTURE(difference);
+  CHECK(difference < 1e-13);
+  CHECK_THROWS_AS(tsi::set_fft_threads(0), tsi::ConfigError);
+
+  const tsi::test::TempDir dir("tsi-nls-threads");
+  const auto r = tsi::test::run_tsi(
+      {"--fft-threads", "2", "run", tsi::test::example_config("nls-se1.json"), "--out", dir / "out"});
+  CHECK_MESSAGE(r.exit_code == 0, r.describe());
+  const auto bad = tsi::test::run_tsi({"run", tsi::test::example_config("nls-se1.json"), "--fft-threads", "0"});
+  CHECK(bad.exit_code == 2);
+  CHECK(tsi::test::contains(bad.err, "--fft-threads"));
 }
