@@ -80,6 +80,12 @@ def step_table(bench):
             model = name.split("/")[1]
             fft = bench[f"fft_bound/{model}"]["real_time"]
             lines.append(f"    {model:<20}{b['real_time']:>10.0f} ns  bound {fft:>8.0f} ns  ratio {b['real_time'] / fft:.2f}")
+    lines.append("  the same with FFTW on two threads (tsi --fft-threads 2; used from 65536 values per batch):")
+    for name, b in bench.items():
+        if name.startswith("nonlinearity_threads/"):
+            model = name.split("/")[1]
+            one = bench[f"nonlinearity/{model}"]["real_time"]
+            lines.append(f"    {model:<20}{b['real_time']:>10.0f} ns  one thread {one:>8.0f} ns  speed-up {one / b['real_time']:.2f}")
     lines.append("  SE1 step at eps = 1 and eps = 1e-6 (cost independent of eps):")
     for name, b in bench.items():
         if name.startswith("step_eps/") and name.endswith("/1"):
