@@ -206,6 +206,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
                                              stats.not_converged));
   result["rhs_evaluations"] = reformulation->evaluations();
   result["tau_roughness_max"] = recorder.roughness_max();
+  result["tau_spread_max"] = recorder.spread_max();
   result["wall_seconds"] = wall;
 
   if (outcome.ok && config.contains("reference")) {

@@ -9,7 +9,8 @@ namespace tsi::app {
 /// What a run records at every step: the invariants H, I, m and their largest relative
 /// changes, the tau roughness, and the rows of invariants.csv. It also watches the run:
 /// a non-finite solution or err_H above monitor.max_err_H stops it (blow-up), and a tau
-/// profile rougher than monitor.tau_roughness_warn is reported once.
+/// profile rougher than monitor.tau_roughness_warn, or one whose spread away from its tau
+/// mean grew by monitor.tau_spread_growth_warn, is reported once.
 class RunRecorder {
  public:
   RunRecorder(const Model& model, Reformulation& reformulation, const Vector& u0, const Json& config);
@@ -27,6 +28,7 @@ class RunRecorder {
 
   Json invariants_json() const;
   double roughness_max() const { return roughness_max_; }
+  double spread_max() const { return spread_max_; }
   const Json& warnings() const { return warnings_; }
   const std::string& csv() const { return csv_; }
 
@@ -37,12 +39,12 @@ class RunRecorder {
   const Model& model_;
   Reformulation& reformulation_;
   long every_, n_steps_;
-  double max_err_H_, roughness_warn_;
+  double max_err_H_, roughness_warn_, spread_growth_warn_;
   Track tracks_[3];  // H, I, m
   Vector u_;
   long steps_ = 0;
-  double t_ = 0.0, roughness_max_ = 0.0;
-  bool roughness_warned_ = false;
+  double t_ = 0.0, roughness_max_ = 0.0, spread_max_ = 0.0, spread_baseline_ = 0.0;
+  bool roughness_warned_ = false, spread_warned_ = false;
   std::string status_ = "running", message_, csv_;
   Json warnings_ = Json::array();
 };

@@ -110,6 +110,12 @@ Matrix TwoScale::r2(const Vector& w) {
          apply_A(apply_A(df_coefficients(w_grid, mean_f_grid)));
 }
 
+double TwoScale::tau_spread(const Vector& y) const {
+  const Eigen::Map<const Matrix> c(y.data(), dim_, n_tau_);
+  const double total = c.squaredNorm();
+  return total > 0.0 ? (total - c.col(0).squaredNorm()) / total : 0.0;
+}
+
 Vector TwoScale::evaluate(const Matrix& c, double tau) const {
   Vector value = Vector::Zero(dim_);
   for (int j = 0; j < n_tau_; ++j) {

@@ -24,6 +24,7 @@ class TwoScale final : public Reformulation {
   /// u(t) = e^{JM t/eps} U(t, t/eps), U evaluated off the grid by its interpolant.
   Vector read_back(const Vector& y, double t) override;
   double tau_roughness(const Vector& y) const override;
+  double tau_spread(const Vector& y) const override;
 
  private:
   /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau).

@@ -382,3 +382,31 @@ TEST_CASE("run: per-step solver statistics, and the stop policy for an unconverg
 }
 
 }  // TEST_SUITE
+
+TEST_CASE("run: U's characteristics coming apart is reported, and the largest spread recorded") {
+  // NLS at eps = 0.5, SE1, h = 1/20: the spread of U away from its tau mean sits at 6e-5 and
+  // then grows about e^{0.3 t}; by t = 40 the mass has changed by tens of percent while the
+  // roughness monitor (top of the tau spectrum) is still far below its threshold.
+  TempDir dir;
+  const std::string out = dir / "out";
+  const std::vector<std::string> nls = {"--set", "model.eps=0.5", "--set", "time.h=0.05", "--set", "time.t_end=40",
+                                        "--set", "reference=null", "--set", "output.every=20"};
+  std::vector<std::string> args = {"run", example_config("nls-se1.json"), "--out", out};
+  args.insert(args.end(), nls.begin(), nls.end());
+  const CommandResult r = run_tsi(args);
+  INFO(r.describe());
+  CHECK(r.exit_code == 0);
+  CHECK(contains(r.out, "lost its coherence"));
+  const Json result = read_json(fs::path(out) / "result.json");
+  CHECK(result.at("tau_spread_max").get<double>() > 1e-2);
+  CHECK(result.at("invariants").at("m").at("max_rel_error").get<double>() > 1e-2);  // what the warning is about
+  // At eps = 0.01 the characteristics stay together: no warning, the mass is kept.
+  args.push_back("--set");
+  args.push_back("model.eps=0.01");
+  const CommandResult coherent = run_tsi(args);
+  CHECK(coherent.exit_code == 0);
+  CHECK_FALSE(contains(coherent.out, "coherence"));
+  const Json kept = read_json(fs::path(out) / "result.json");
+  CHECK(kept.at("invariants").at("m").at("max_rel_error").get<double>() < 1e-4);
+  CHECK(kept.at("tau_spread_max").get<double>() < 1e-6);
+}

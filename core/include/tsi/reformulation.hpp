@@ -19,6 +19,10 @@ class TSI_API Reformulation : public Problem {
   virtual Vector read_back(const Vector& y, double t) = 0;
   /// Fraction of the energy of y in the top quarter of the tau spectrum (0 without tau).
   virtual double tau_roughness(const Vector& /*y*/) const { return 0.0; }
+  /// Fraction of the energy of y away from its tau mean (the non-zero tau modes; 0 without
+  /// tau). Each characteristic tau - t/eps = const of U is a trajectory of the model; this
+  /// measures how far they have spread apart, which the run recorder watches for growth.
+  virtual double tau_spread(const Vector& /*y*/) const { return 0.0; }
 
   const Model& model() const { return *model_; }
 
