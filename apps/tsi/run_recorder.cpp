@@ -66,8 +66,9 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
     warnings_.push_back(fmt::format(
         "the tau profile of U lost its coherence at t = {:.6g}: the fraction of its energy away from the "
         "tau mean grew from {:.2e} after the first step to {:.2e} (monitor.tau_spread_growth_warn = {:g}); "
-        "the characteristics of U have come apart, and errors and invariants past this time are not "
-        "reliable (seen for eps >= 0.1 over long times; a smaller eps, h or another scheme may delay it)",
+        "the characteristics of U have come apart, so the solution past this time mixes different "
+        "trajectories and its error and invariants may be far off (seen over long times for eps >= 0.1, "
+        "or with large h; a smaller h or another scheme may delay it)",
         t, spread_baseline_, spread, spread_growth_warn_));
   }
   u_ = u;
