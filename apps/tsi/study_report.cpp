@@ -139,6 +139,7 @@ Json study_rows(const Study& study, const std::vector<RunOutcome>& outcomes) {
     for (const auto& [path, value] : run.assignments.items())
       if (!covered.count(path)) varied[path] = value;
     row["varied"] = varied;
+    row["warnings"] = r.value("warnings", Json::array());
     rows.push_back(row);
   }
   // Observed order against the next larger h in the same series.
@@ -272,6 +273,15 @@ std::string study_text(const Study& study, const Json& rows) {
                        row["id"].get<std::string>(), row["scheme"].get<std::string>(), row["eps"].get<double>(),
                        row["h"].get<double>(), row["message"].get<std::string>());
     }
+  // Warnings of completed runs (tau roughness, coherence, unconverged stages): their first clause.
+  for (const auto& row : rows)
+    if (row["status"] == "completed")
+      for (const auto& w : row.value("warnings", Json::array())) {
+        const std::string text = w.get<std::string>();
+        s += fmt::format("  warning {} ({}, eps = {:g}, h = {:g}): {}\n", row["id"].get<std::string>(),
+                         row["scheme"].get<std::string>(), row["eps"].get<double>(), row["h"].get<double>(),
+                         text.substr(0, text.find(':')));
+      }
   if (study.kind == "convergence") {
     const Json summary = convergence_summary(rows);
     std::map<std::string, std::vector<const Json*>> groups;  // one table per series without eps

@@ -83,6 +83,30 @@ TEST_CASE("study: a failing run is recorded with its message and the others comp
   CHECK(failed == 2);
 }
 
+TEST_CASE("study: a completed run's warnings are listed, and kept in study.json") {
+  // NLS at eps = 0.5 with SE1 loses its coherence in tau by t = 40 (see test_run_command.cpp);
+  // at eps = 0.01 it does not.
+  TempDir dir;
+  const Json spec = {{"kind", "conservation"},
+                     {"base", {{"model", {{"name", "nls"}}},
+                               {"scheme", {{"name", "se1"}}},
+                               {"time", {{"t_end", 40.0}, {"h", 0.05}}},
+                               {"output", {{"every", 20}}}}},
+                     {"vary", {{"model.eps", {0.5, 0.01}}}}};
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"study", write_config(dir, spec, "study.json"), "--out", out, "--no-plots"});
+  INFO(r.describe());
+  CHECK(r.exit_code == 0);
+  CHECK(contains(r.out, "warning r0001 (se1, eps = 0.5, h = 0.05): the tau profile of U lost its coherence at t = "));
+  CHECK_FALSE(contains(r.out, "warning r0002"));
+  const Json study = read_json(fs::path(out) / "study.json");
+  REQUIRE(study["table"].size() == 2);
+  // The coherence warning comes first; the roughness one follows a little later.
+  REQUIRE(study["table"][0]["warnings"].size() >= 1);
+  CHECK(contains(study["table"][0]["warnings"][0].get<std::string>(), "lost its coherence"));
+  CHECK(study["table"][1]["warnings"].empty());
+}
+
 TEST_CASE("study: a bad path is rejected before any run, naming the run and the path") {
   TempDir dir;
   Json spec = small_study();
