@@ -31,8 +31,8 @@ class TSI_API Model {
   /// The field of the two-scale and filtered problems, f_tau(u) = e^{-JM tau} J grad H1(e^{JM tau} u),
   /// for column j at tau = taus[j]; minus_taus is -taus. `states` is scratch: it may be left
   /// overwritten. The default is linear_flow, nonlinear_field and linear_flow at -tau, three
-  /// passes over the tau grid; a model may fuse them into one (Henon-Heiles and the charged
-  /// particle do: a sweep's largest cost after the FFTs). `tsi check` compares the two.
+  /// passes over the tau grid; a model may fuse them into one (the shipped models do: after
+  /// the FFTs, this is a sweep's largest cost). `tsi check` compares the two.
   virtual void filtered_field(const RealVector& taus, const RealVector& minus_taus, MatrixRef states,
                               MatrixRef out) const;
   /// J Hess H1(u) z for every column pair (u, z): the field's derivative at u in direction z.
