@@ -22,8 +22,6 @@ void set_fft_threads(int threads, long min_values) {
   threads_min_values = min_values;
 }
 
-int fft_threads() { return threads_setting; }
-
 FftBatch::FftBatch(int n, int howmany) : n_(n), howmany_(howmany) {
   if (n <= 0 || howmany <= 0) throw Error("FftBatch: sizes must be positive");
   std::lock_guard<std::mutex> lock(planner_mutex);

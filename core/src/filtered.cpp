@@ -24,13 +24,13 @@ void Filtered::nonlinear(double t, const Vector& y, Vector& out) {
 
 void Filtered::nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) {
   tau_(0) = fast_phase(t, model_->eps());
+  minus_tau_(0) = -tau_(0);
   state_.col(0) = y;
   direction_.col(0) = dy;
   model_->linear_flow(tau_, state_);
   model_->linear_flow(tau_, direction_);
   model_->nonlinear_field_derivative(state_, direction_, field_);
-  tau_(0) = -tau_(0);
-  model_->linear_flow(tau_, field_);
+  model_->linear_flow(minus_tau_, field_);
   out = field_.col(0);
 }
 

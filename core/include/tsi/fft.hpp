@@ -11,8 +11,6 @@ namespace tsi {
 /// now on (1, the default, for none: a study already runs one run per core). Small batches
 /// (Henon-Heiles, NLS with n_x = 16) stay on one thread, where splitting costs more than it saves.
 TSI_API void set_fft_threads(int threads, long min_values = 65536);
-/// The current setting of set_fft_threads.
-TSI_API int fft_threads();
 
 /// In-place complex FFTs along the tau direction of a batch of states stored column by
 /// column (howmany rows, n columns; entry (i, j) at i + howmany * j). Plans are made once
