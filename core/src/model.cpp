@@ -35,11 +35,51 @@ void Model::nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef dir
   }
 }
 
-void Model::filtered_field(const RealVector& taus, const RealVector& minus_taus, MatrixRef states,
-                           MatrixRef out) const {
+void Model::filtered_field(const RealVector& taus, MatrixRef states, MatrixRef out) const {
   linear_flow(taus, states);
   nonlinear_field(states, out);
+  const RealVector minus_taus = -taus;
   linear_flow(minus_taus, out);
+}
+
+namespace {
+
+// The default binding: the model's filtered_field with the stored phases.
+class StoredPhasesField final : public TauGridField {
+ public:
+  StoredPhasesField(const Model& model, RealVector taus) : model_(model), taus_(std::move(taus)) {}
+  void evaluate(MatrixRef states, MatrixRef out) override { model_.filtered_field(taus_, states, out); }
+
+ private:
+  const Model& model_;
+  RealVector taus_;
+};
+
+}  // namespace
+
+std::unique_ptr<TauGridField> Model::bind_tau_grid(const RealVector& taus) const {
+  return std::make_unique<StoredPhasesField>(*this, taus);
+}
+
+const RealVector& Model::linear_remainder() const {
+  static const RealVector none;
+  return none;
+}
+
+void Model::remainder_flow(double t, Vector& u) const {
+  const RealVector& omega = linear_remainder();
+  if (omega.size() == 0) return;
+  for (Index j = 0; j < u.size(); ++j) u(j) *= std::polar(1.0, omega(j) * t);
+}
+
+double Model::remainder_energy(const Vector& u) const {
+  const RealVector& omega = linear_remainder();
+  if (omega.size() == 0) return 0.0;
+  // R u = -J (i omega . u), since J^{-1} = -J for a symplectic J.
+  const Vector i_omega_u = (Complex(0.0, 1.0) * omega.cast<Complex>()).cwiseProduct(u);
+  Vector r(u.size());
+  apply_J(i_omega_u, r);
+  return -0.5 * inner(r, u);
 }
 
 void Model::nonlinear_flow(double /*t*/, Vector& /*u*/) const {

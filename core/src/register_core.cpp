@@ -1,9 +1,9 @@
 #include <memory>
 
-#include "direct.hpp"
-#include "filtered.hpp"
+#include "reformulations/direct.hpp"
+#include "reformulations/filtered.hpp"
 #include "tsi/registry.hpp"
-#include "two_scale.hpp"
+#include "reformulations/two_scale.hpp"
 
 namespace tsi {
 

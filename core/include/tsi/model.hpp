@@ -1,12 +1,39 @@
 #pragma once
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
 #include "tsi/export.hpp"
 #include "tsi/types.hpp"
 
 namespace tsi {
 
-/// The problem class of the paper (eq. model):
-///     u' = J [ (1/eps) M u + grad H1(u) ],   eps in (0, 1],
-/// J symplectic, M self-adjoint, JM = MJ, and tau -> e^{JM tau} 2*pi-periodic.
+/// f_tau over one fixed set of phases (a run's tau grid), bound once per run by
+/// Model::bind_tau_grid: what the model precomputes for those phases (rotation tables, phase
+/// factors, transform buffers) lives here, so an evaluation neither receives the phases again
+/// nor has to recognise them.
+class TSI_API TauGridField {
+ public:
+  virtual ~TauGridField() = default;
+  /// out.col(j) = f_{tau_j}(states.col(j)) for the bound phases tau_j. `states` is scratch:
+  /// it may be left overwritten.
+  virtual void evaluate(MatrixRef states, MatrixRef out) = 0;
+};
+
+/// A quantity a model declares as conserved (or nearly) besides H, I and m: runs record its
+/// relative change and plot it (NLS: the momentum; charged particle: the magnetic moment).
+struct TSI_API ModelInvariant {
+  std::string name;         ///< a column name: letters, digits and '_' ("P", "mu")
+  std::string description;  ///< one line, for the run's files and plots
+  std::function<double(const Vector& u)> value;  ///< of a state in model variables
+};
+
+/// The problem class of the paper (eq. model), with an optional second linear part R:
+///     u' = J [ (1/eps) M u + R u + grad H1(u) ],   eps in (0, 1],
+/// J symplectic, M self-adjoint, JM = MJ, and tau -> e^{JM tau} 2*pi-periodic. R (default: none)
+/// is a linear part bounded in eps but possibly large (a spatial operator), handed over so that
+/// every reformulation and scheme integrates it exactly instead of through H1 (linear_remainder).
 /// A model states its operators by their action; batched calls take one state per column
 /// so that the two-scale reformulation evaluates all tau points in one call.
 class TSI_API Model {
@@ -29,12 +56,14 @@ class TSI_API Model {
   /// J grad H1(u) for every column u of `states` (the nonlinear vector field).
   virtual void nonlinear_field(ConstMatrixRef states, MatrixRef out) const = 0;
   /// The field of the two-scale and filtered problems, f_tau(u) = e^{-JM tau} J grad H1(e^{JM tau} u),
-  /// for column j at tau = taus[j]; minus_taus is -taus. `states` is scratch: it may be left
-  /// overwritten. The default is linear_flow, nonlinear_field and linear_flow at -tau, three
-  /// passes over the tau grid; a model may fuse them into one (the shipped models do: after
-  /// the FFTs, this is a sweep's largest cost). `tsi check` compares the two.
-  virtual void filtered_field(const RealVector& taus, const RealVector& minus_taus, MatrixRef states,
-                              MatrixRef out) const;
+  /// for column j at tau = taus[j]. `states` is scratch: it may be left overwritten. The default
+  /// is linear_flow, nonlinear_field and linear_flow at -tau, three passes; a model may fuse
+  /// them into one. `tsi check` compares the two.
+  virtual void filtered_field(const RealVector& taus, MatrixRef states, MatrixRef out) const;
+  /// f_tau on a run's fixed tau grid, bound once (the two-scale reformulation's hot path:
+  /// after the FFTs, this is a sweep's largest cost). The default calls filtered_field with
+  /// the stored phases; the shipped models return an object with their tables precomputed.
+  virtual std::unique_ptr<TauGridField> bind_tau_grid(const RealVector& taus) const;
   /// J Hess H1(u) z for every column pair (u, z): the field's derivative at u in direction z.
   /// The default is a central difference; models with a closed form should override it.
   virtual void nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef directions,
@@ -46,12 +75,26 @@ class TSI_API Model {
   /// The non-stiff part H1 of the Hamiltonian.
   virtual double H1(const Vector& u) const = 0;
 
+  /// The second linear part R, by the frequencies omega_j of J R: J R multiplies coordinate j
+  /// of u by i omega_j. It must commute with JM (tsi check tests it) and, for a real model, be
+  /// empty (a real state cannot turn by a complex phase). Empty (the default): no remainder.
+  /// Klein-Gordon's omega_k = <D>_eps - 1/eps = k^2 / (1 + sqrt(1 + eps k^2)): bounded in eps,
+  /// up to (n_x/2)^2/2 in k, so that in H1 it would limit every scheme to h <~ 2 / max omega.
+  virtual const RealVector& linear_remainder() const;
+  bool has_linear_remainder() const { return linear_remainder().size() > 0; }
+  /// u <- e^{J R t} u (coordinate j times e^{i omega_j t}); nothing without a remainder.
+  void remainder_flow(double t, Vector& u) const;
+
   /// Oscillatory energy I(u) = <Mu, u> / (2 eps).
   virtual double oscillatory_energy(const Vector& u) const;
+  /// Energy of the remainder, <R u, u> / 2 with R u = -J (i omega . u) (0 without one).
+  double remainder_energy(const Vector& u) const;
   /// Mass m(u) = <u, u>.
   virtual double mass(const Vector& u) const;
-  /// Energy H(u) = I(u) + H1(u), exactly conserved by the flow.
-  double energy(const Vector& u) const { return oscillatory_energy(u) + H1(u); }
+  /// Energy H(u) = I(u) + <Ru, u>/2 + H1(u), exactly conserved by the flow.
+  double energy(const Vector& u) const { return oscillatory_energy(u) + remainder_energy(u) + H1(u); }
+  /// The model's own invariants beyond H, I and m (none by default).
+  virtual std::vector<ModelInvariant> invariants() const { return {}; }
 
   /// The largest |lambda| over the eigenvalues i*lambda of JM (integers, since e^{JM tau} is
   /// 2*pi-periodic): e^{JM tau} oscillates with frequencies up to this. 1 by default

@@ -18,7 +18,6 @@
 #include "tsi/error.hpp"
 #include "tsi/model.hpp"
 #include "tsi/plugin.hpp"
-#include "tsi/rotation_cache.hpp"
 
 namespace {
 
@@ -40,9 +39,8 @@ class ChargedParticle final : public tsi::Model {
   bool is_complex() const override { return false; }
 
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
-    const auto& table = half_angles_.get(taus);
     for (Index j = 0; j < u.cols(); ++j) {
-      const double c = table.cos(j), s = table.sin(j);
+      const double c = std::cos(0.5 * taus(j)), s = std::sin(0.5 * taus(j));
       // The model is real: compute with real parts (imaginary parts on the grid are rounding).
       const double q1 = u(0, j).real(), q2 = u(1, j).real(), p1 = u(2, j).real(), p2 = u(3, j).real();
       // a = c q + s p, b = -s q + c p, then R applied to both.
@@ -79,9 +77,29 @@ class ChargedParticle final : public tsi::Model {
   // (0, 0, k q) turns back by -tau. In blocks of columns, so that the Coulomb factor (a square
   // root and a division per point, the bulk of the work) runs over contiguous arrays the
   // compiler vectorises.
-  void filtered_field(const tsi::RealVector& taus, const tsi::RealVector& /*minus_taus*/, MatrixRef u,
-                      MatrixRef out) const override {
-    const auto& table = half_angles_.get(taus);
+  void filtered_field(const tsi::RealVector& taus, MatrixRef u, MatrixRef out) const override {
+    const tsi::RealVector c = (0.5 * taus.array()).cos(), s = (0.5 * taus.array()).sin();
+    fused_field(c, s, u, out);
+  }
+
+  // A run's tau grid: cos(tau/2) and sin(tau/2) computed once.
+  class GridField final : public tsi::TauGridField {
+   public:
+    GridField(const ChargedParticle& model, const tsi::RealVector& taus)
+        : model_(model), cos_((0.5 * taus.array()).cos()), sin_((0.5 * taus.array()).sin()) {}
+    void evaluate(MatrixRef u, MatrixRef out) override { model_.fused_field(cos_, sin_, u, out); }
+
+   private:
+    const ChargedParticle& model_;
+    tsi::RealVector cos_, sin_;
+  };
+
+  std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
+    return std::make_unique<GridField>(*this, taus);
+  }
+
+  // f_tau with c = cos(tau_j / 2), s = sin(tau_j / 2) given per column.
+  void fused_field(const tsi::RealVector& cos, const tsi::RealVector& sin, MatrixRef u, MatrixRef out) const {
     const double two_eps = 2.0 * eps();
     constexpr Index block = 16;
     double x1[block], x2[block], k[block];
@@ -89,7 +107,7 @@ class ChargedParticle final : public tsi::Model {
       const Index m = std::min(block, u.cols() - j0);
       for (Index i = 0; i < m; ++i) {
         const Index j = j0 + i;
-        const double c = table.cos(j), s = table.sin(j);
+        const double c = cos(j), s = sin(j);
         const double q1 = u(0, j).real(), q2 = u(1, j).real(), p1 = u(2, j).real(), p2 = u(3, j).real();
         const double a1 = c * q1 + s * p1, a2 = c * q2 + s * p2;
         x1[i] = c * a1 + s * a2;  // q of e^{JM tau} u
@@ -105,7 +123,7 @@ class ChargedParticle final : public tsi::Model {
       }
       for (Index i = 0; i < m; ++i) {
         const Index j = j0 + i;
-        const double c = table.cos(j), s = table.sin(j);
+        const double c = cos(j), s = sin(j);
         const double f1 = k[i] * x1[i], f2 = k[i] * x2[i];
         // linear_flow at -tau (sin -> -sin) applied to (0, 0, f1, f2).
         const double b1 = -s * f1, b2 = -s * f2, d1 = c * f1, d2 = c * f2;
@@ -187,7 +205,6 @@ class ChargedParticle final : public tsi::Model {
   }
 
   Potential potential_;
-  mutable tsi::RotationCache half_angles_{0.5};  // cos(tau/2), sin(tau/2) of the tau grid
 };
 
 void register_cpd(tsi::Registry& registry) {

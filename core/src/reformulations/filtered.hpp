@@ -4,27 +4,29 @@
 
 namespace tsi {
 
-/// The filtered problem (eq. filtered): v = e^{-JM t/eps} u,  v' = f_{t/eps}(v).
-/// No stiff linear part (L = 0, diagonal), but non-autonomous with period 2*pi*eps in t.
+/// The filtered problem (eq. filtered): v = e^{-JM t/eps} u,  v' = J R v + f_{t/eps}(v).
+/// No stiff linear part: L = J R, the model's remainder (diagonal, i omega; zero without one),
+/// which exponential schemes integrate exactly. Non-autonomous with period 2*pi*eps in t.
 class Filtered final : public Reformulation {
  public:
   explicit Filtered(std::shared_ptr<const Model> model);
 
   Index size() const override { return model_->dim(); }
-  const Vector& linear_multipliers() const override { return zeros_; }
+  const Vector& linear_multipliers() const override { return multipliers_; }
   bool autonomous() const override { return false; }
   /// The shortest period of the explicit time dependence: 2 pi eps over the model's
   /// largest linear frequency (2 pi eps for Henon-Heiles; 2 pi eps / 64 for NLS with N_x = 16).
   double fast_period() const override { return two_pi * model_->eps() / model_->max_linear_frequency(); }
   void nonlinear(double t, const Vector& y, Vector& out) override;
   void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
-  void rhs(double t, const Vector& y, Vector& out) override { nonlinear(t, y, out); }
+  void rhs(double t, const Vector& y, Vector& out) override;
 
   Vector prepare(const Vector& u0) override { return u0; }
   Vector read_back(const Vector& y, double t) override;
 
  private:
-  Vector zeros_;
+  Vector multipliers_;  // i omega of the remainder, or zeros
+  bool has_remainder_;
   RealVector tau_, minus_tau_;  // one phase and its negative, reused
   Matrix state_, direction_, field_;
 };

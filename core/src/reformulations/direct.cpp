@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "remainder.hpp"
 #include "tsi/error.hpp"
 
 namespace tsi {
@@ -38,7 +39,8 @@ Direct::Direct(std::shared_ptr<const Model> model, Variables variables)
       direction_(model_->dim(), 1),
       field_(model_->dim(), 1),
       mu_(model_->dim()),
-      jmu_(model_->dim()) {
+      jmu_(model_->dim()),
+      remainder_(remainder_multipliers(*model_)) {
   if (physical_) {
     require_linear_to_physical(*model_);
     size_ = model_->to_physical(model_->initial_value()).size();
@@ -56,6 +58,7 @@ void Direct::model_rhs(const Vector& u, Vector& out) {
   model_->apply_M(u, mu_);
   model_->apply_J(mu_, jmu_);
   out += jmu_ / model_->eps();
+  if (remainder_.size()) out += remainder_.cwiseProduct(u);
 }
 
 void Direct::nonlinear(double /*t*/, const Vector& y, Vector& out) {

@@ -1,24 +1,32 @@
 #include "filtered.hpp"
 
+#include "remainder.hpp"
 #include "tsi/phase.hpp"
 
 namespace tsi {
 
 Filtered::Filtered(std::shared_ptr<const Model> model)
     : Reformulation(std::move(model)),
-      zeros_(Vector::Zero(model_->dim())),
+      multipliers_(remainder_multipliers(*model_)),
+      has_remainder_(multipliers_.size() > 0),
       tau_(1),
       minus_tau_(1),
       state_(model_->dim(), 1),
       direction_(model_->dim(), 1),
-      field_(model_->dim(), 1) {}
+      field_(model_->dim(), 1) {
+  if (!has_remainder_) multipliers_ = Vector::Zero(model_->dim());
+}
+
+void Filtered::rhs(double t, const Vector& y, Vector& out) {
+  nonlinear(t, y, out);
+  if (has_remainder_) out += multipliers_.cwiseProduct(y);
+}
 
 void Filtered::nonlinear(double t, const Vector& y, Vector& out) {
   ++evaluations_;
   tau_(0) = fast_phase(t, model_->eps());
-  minus_tau_(0) = -tau_(0);
   state_.col(0) = y;
-  model_->filtered_field(tau_, minus_tau_, state_, field_);
+  model_->filtered_field(tau_, state_, field_);
   out = field_.col(0);
 }
 

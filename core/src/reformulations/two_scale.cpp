@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "remainder.hpp"
 #include "tsi/error.hpp"
 #include "tsi/phase.hpp"
 
@@ -14,7 +15,7 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
       data_order_(initial_data_order),
       eps_(model_->eps()),
       taus_(n_tau),
-      minus_taus_(n_tau),
+      remainder_(remainder_multipliers(*model_)),
       wave_numbers_(n_tau),
       multipliers_(dim_ * n_tau),
       fft_(n_tau, static_cast<int>(model_->dim())),
@@ -27,12 +28,13 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
                       "got " + std::to_string(initial_data_order) + ", expected 1, 2 or 3");
   for (int j = 0; j < n_tau; ++j) {
     taus_(j) = two_pi * j / n_tau;
-    minus_taus_(j) = -taus_(j);
     wave_numbers_(j) = j <= n_tau / 2 ? j : j - n_tau;
-    // Nyquist: multiplier 0, as the Fourier differentiation matrix has it.
+    // Nyquist: -i k / eps is 0 there, as the Fourier differentiation matrix has it.
     const double k = (2 * j == n_tau) ? 0.0 : wave_numbers_(j);
     multipliers_.segment(j * dim_, dim_).setConstant(Complex(0.0, -k / eps_));
+    if (remainder_.size()) multipliers_.segment(j * dim_, dim_) += remainder_;
   }
+  grid_field_ = model_->bind_tau_grid(taus_);
 }
 
 void TwoScale::nonlinear(double /*t*/, const Vector& y, Vector& out) {
@@ -41,7 +43,7 @@ void TwoScale::nonlinear(double /*t*/, const Vector& y, Vector& out) {
   auto field = field_fft_.data();
   grid = Eigen::Map<const Matrix>(y.data(), dim_, n_tau_);
   fft_.backward();
-  model_->filtered_field(taus_, minus_taus_, grid, field);
+  grid_field_->evaluate(grid, field);
   field_fft_.forward_unnormalised();
   out.resize(size());
   Eigen::Map<Matrix>(out.data(), dim_, n_tau_) = field * (1.0 / n_tau_);  // the 1/n of the transform
@@ -69,7 +71,7 @@ Matrix TwoScale::to_grid(const Matrix& c) {
 Matrix TwoScale::f_coefficients(const Matrix& grid) {
   Matrix w = grid;
   Matrix f(dim_, n_tau_);
-  model_->filtered_field(taus_, minus_taus_, w, f);
+  grid_field_->evaluate(w, f);
   auto buffer = fft_.data();
   buffer = f;
   fft_.forward();
@@ -82,7 +84,7 @@ Matrix TwoScale::df_coefficients(const Matrix& grid, const Matrix& direction_gri
   model_->linear_flow(taus_, z);
   Matrix df(dim_, n_tau_);
   model_->nonlinear_field_derivative(w, z, df);
-  model_->linear_flow(minus_taus_, df);
+  model_->linear_flow(RealVector(-taus_), df);
   auto buffer = fft_.data();
   buffer = df;
   fft_.forward();
@@ -105,9 +107,11 @@ Matrix TwoScale::r2(const Vector& w) {
   const Matrix w_grid = w.replicate(1, n_tau_);
   const Matrix f = f_coefficients(w_grid);
   const Matrix af_grid = to_grid(apply_A(f));
-  const Matrix mean_f_grid = f.col(0).replicate(1, n_tau_);  // Pi f(w), constant in tau
-  return apply_A(df_coefficients(w_grid, af_grid)) -
-         apply_A(apply_A(df_coefficients(w_grid, mean_f_grid)));
+  Vector drift = f.col(0);  // the averaged field at w, Pi f(w) + JR w: constant in tau
+  if (remainder_.size()) drift += remainder_.cwiseProduct(w);
+  Matrix r = apply_A(df_coefficients(w_grid, af_grid)) - apply_A(apply_A(df_coefficients(w_grid, drift.replicate(1, n_tau_))));
+  if (remainder_.size()) r += remainder_.asDiagonal() * apply_A(apply_A(f));
+  return r;
 }
 
 double TwoScale::tau_spread(const Vector& y) const {

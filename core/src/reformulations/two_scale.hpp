@@ -5,9 +5,10 @@
 namespace tsi {
 
 /// The two-scale reformulation (eq. 2scale eq): U(t, tau) on N_tau Fourier modes,
-///     dU/dt = L U + f_tau(U),   L = -(1/eps) d/dtau,
+///     dU/dt = L U + f_tau(U),   L = -(1/eps) d/dtau + J R,
 /// stored as Fourier coefficients, d x N_tau column-major (column j = mode j), so that L is
-/// diagonal. The Nyquist mode's multiplier is 0 (SPEC.md section 2).
+/// diagonal: -i k / eps + i omega_i for tau mode k and model coordinate i (omega: the model's
+/// remainder, zero without one). The Nyquist mode's -i k / eps is 0 (SPEC.md section 2).
 class TwoScale final : public Reformulation {
  public:
   TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order);
@@ -37,7 +38,8 @@ class TwoScale final : public Reformulation {
   Matrix apply_A(Matrix c) const;
   /// r1(w) = A f_.(w), as coefficients.
   Matrix r1(const Vector& w);
-  /// r2(w) = A[Df(w) A f(w)] - A^2[Df(w) Pi f(w)], as coefficients.
+  /// r2(w) = A[Df(w) A f(w)] - A^2[Df(w) (Pi f(w) + JR w)] + JR A^2 f(w), as coefficients
+  /// (SPEC.md's r2; the JR terms come from the remainder in the averaged flow).
   Matrix r2(const Vector& w);
   /// The trigonometric interpolant of coefficients c at tau (Nyquist split half/half).
   Vector evaluate(const Matrix& c, double tau) const;
@@ -46,7 +48,9 @@ class TwoScale final : public Reformulation {
   int n_tau_;
   int data_order_;
   double eps_;
-  RealVector taus_, minus_taus_;
+  RealVector taus_;
+  Vector remainder_;  // i omega per model coordinate (empty without a remainder)
+  std::unique_ptr<TauGridField> grid_field_;  // f_tau on taus_, bound once
   RealVector wave_numbers_;  // k of each Fourier index; the Nyquist index holds n/2
   Vector multipliers_;
   FftBatch fft_;        // U's coefficients -> its values on the tau grid

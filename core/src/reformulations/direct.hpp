@@ -4,8 +4,9 @@
 
 namespace tsi {
 
-/// The model as it stands: y = u, y' = (1/eps) JM y + J grad H1(y). L is not diagonal in
-/// these coordinates, so only schemes that use rhs() (classical solvers) apply.
+/// The model as it stands: y = u, y' = (1/eps) JM y + J R y + J grad H1(y). L is not diagonal
+/// in these coordinates, so only schemes that use rhs() (classical solvers) or the exact flows
+/// (splitting: e^{hL} = e^{JR h} e^{JM h/eps}, the remainder included) apply.
 ///
 /// With Variables::physical the state is x = T u, T = the model's to_physical, and
 /// x' = T F(T^{-1} x): the problem as a user would integrate it in the variables errors are
@@ -26,7 +27,10 @@ class Direct final : public Reformulation {
 
   /// Exact flows when the model has an exact nonlinear flow: e^{hL} = e^{JM h/eps}.
   bool has_exact_flows() const override { return !physical_ && model_->has_exact_nonlinear_flow(); }
-  void linear_flow(double h, Vector& y) override { y = model_->linear_flow(fast_phase(h, model_->eps()), y); }
+  void linear_flow(double h, Vector& y) override {
+    y = model_->linear_flow(fast_phase(h, model_->eps()), y);
+    model_->remainder_flow(h, y);
+  }
   /// One exact nonlinear flow counts as one evaluation of N (the work measure of splitting).
   void nonlinear_flow(double /*t*/, double h, Vector& y) override {
     ++evaluations_;
@@ -45,6 +49,7 @@ class Direct final : public Reformulation {
   Vector none_;
   Matrix state_, direction_, field_;
   Vector mu_, jmu_;
+  Vector remainder_;  // i omega per coordinate (empty without a remainder)
 };
 
 }  // namespace tsi

@@ -6,7 +6,6 @@
 
 #include "tsi/model.hpp"
 #include "tsi/plugin.hpp"
-#include "tsi/rotation_cache.hpp"
 
 namespace {
 
@@ -27,9 +26,8 @@ class HenonHeiles final : public tsi::Model {
   // The model is real (is_complex() is false): the batched functions compute with real
   // parts, which halves their cost against complex arithmetic.
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
-    const auto& table = rotations_.get(taus);
     for (Index j = 0; j < u.cols(); ++j) {
-      const double c = table.cos(j), s = table.sin(j);
+      const double c = std::cos(taus(j)), s = std::sin(taus(j));
       const double q1 = u(0, j).real(), p1 = u(2, j).real();
       u(0, j) = c * q1 + s * p1;
       u(2, j) = -s * q1 + c * p1;
@@ -47,13 +45,30 @@ class HenonHeiles final : public tsi::Model {
     }
   }
 
+  void filtered_field(const tsi::RealVector& taus, MatrixRef u, MatrixRef out) const override {
+    const tsi::RealVector c = taus.array().cos(), s = taus.array().sin();
+    fused_field(c, s, u, out);
+  }
+
+  // A run's tau grid: cos and sin computed once.
+  class GridField final : public tsi::TauGridField {
+   public:
+    explicit GridField(const tsi::RealVector& taus) : cos_(taus.array().cos()), sin_(taus.array().sin()) {}
+    void evaluate(MatrixRef u, MatrixRef out) override { fused_field(cos_, sin_, u, out); }
+
+   private:
+    tsi::RealVector cos_, sin_;
+  };
+
+  std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
+    return std::make_unique<GridField>(taus);
+  }
+
   // The three steps of f_tau in one pass: the flow turns (q1, p1) only, so the field needs
   // the turned q1, and its (q1, p1) part, (0, -2 q1 q2), turns back by -tau.
-  void filtered_field(const tsi::RealVector& taus, const tsi::RealVector& /*minus_taus*/, MatrixRef u,
-                      MatrixRef out) const override {
-    const auto& table = rotations_.get(taus);
+  static void fused_field(const tsi::RealVector& cos, const tsi::RealVector& sin, MatrixRef u, MatrixRef out) {
     for (Index j = 0; j < u.cols(); ++j) {
-      const double c = table.cos(j), s = table.sin(j);
+      const double c = cos(j), s = sin(j);
       const double q1 = c * u(0, j).real() + s * u(2, j).real(), q2 = u(1, j).real(), p2 = u(3, j).real();
       const double g = -2.0 * q1 * q2;
       out(0, j) = -s * g;
@@ -90,9 +105,6 @@ class HenonHeiles final : public tsi::Model {
   }
 
   Vector initial_value() const override { return Vector::Constant(4, 0.12); }
-
- private:
-  mutable tsi::RotationCache rotations_;  // the tau grid's cos and sin, computed once
 };
 
 void register_henon_heiles(tsi::Registry& registry) {

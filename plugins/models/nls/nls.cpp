@@ -14,7 +14,6 @@
 // Physical variables are the samples u_j on the x grid: to_physical is the inverse transform,
 // from_physical the forward one, and errors are measured in the discrete L2 norm
 // sqrt(2 pi / N_x) |u|.
-#include <array>
 #include <cmath>
 #include <complex>
 #include <map>
@@ -68,11 +67,9 @@ class Nls final : public tsi::Model {
   Index dim() const override { return n_x_; }
   bool is_complex() const override { return true; }
 
-  // e^{JM tau}: mode m times e^{-i m^2 tau}, with the phases of the last two tau sets cached
-  // (the two-scale grid and its negative come back at every evaluation).
+  // e^{JM tau}: mode m times e^{-i m^2 tau}.
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    const tsi::Matrix& phase = phases(taus);
+    const tsi::Matrix phase = phase_table(taus, n_x_);
     const int half = n_x_ / 2;
     for (Index j = 0; j < u.cols(); ++j)
       for (int m = 1; m <= half; ++m) {
@@ -96,14 +93,32 @@ class Nls final : public tsi::Model {
     out = w.transpose();
   }
 
+  void filtered_field(const tsi::RealVector& taus, MatrixRef c, MatrixRef out) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    fused_field(phase_table(taus, n_x_), batch(c.cols()), c, out);
+  }
+
+  // A run's tau grid: the phases, and transforms of its own (no lock: one run's work space).
+  class GridField final : public tsi::TauGridField {
+   public:
+    GridField(const Nls& model, const tsi::RealVector& taus)
+        : model_(model), phase_(phase_table(taus, model.n_x_)), batch_(model.n_x_, taus.size()) {}
+    void evaluate(MatrixRef c, MatrixRef out) override { model_.fused_field(phase_, batch_, c, out); }
+
+   private:
+    const Nls& model_;
+    tsi::Matrix phase_;
+    XBatch batch_;
+  };
+
+  std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
+    return std::make_unique<GridField>(*this, taus);
+  }
+
   // f_tau in one pass each way: the phases e^{-i m^2 tau} are applied while the states are
   // copied (transposed) into the x-batch, and their conjugates (the flow at -tau) while the
   // result is copied out; the cubic term is written out in real arithmetic (-i a w = (a im, -a re)).
-  void filtered_field(const tsi::RealVector& taus, const tsi::RealVector& /*minus_taus*/, MatrixRef c,
-                      MatrixRef out) const override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    const tsi::Matrix& phase = phases(taus);
-    XBatch& b = batch(c.cols());
+  void fused_field(const tsi::Matrix& phase, XBatch& b, MatrixRef c, MatrixRef out) const {
     auto w = b.data();  // row j: state j
     const int half = n_x_ / 2;
     for (Index j = 0; j < c.cols(); ++j) {
@@ -236,25 +251,20 @@ class Nls final : public tsi::Model {
 
   // e^{-i m^2 tau_j} for m = 0 .. N_x/2 (rows) and every tau_j (columns), by the recurrence
   // e^{-i (m+1)^2 tau} = e^{-i m^2 tau} e^{-i (2m+1) tau}: one sincos per column, rounding of
-  // a few m^2 ulp (as the rounding of m^2 tau itself). Callers hold mutex_.
-  const tsi::Matrix& phases(const tsi::RealVector& taus) const {
-    for (auto& t : phase_tables_)
-      if (t.taus.size() == taus.size() && t.taus == taus) return t.phases;
-    PhaseTable& t = phase_tables_[next_table_];
-    next_table_ = (next_table_ + 1) % phase_tables_.size();
-    t.taus = taus;
-    t.phases.resize(n_x_ / 2 + 1, taus.size());
+  // a few m^2 ulp (as the rounding of m^2 tau itself).
+  static tsi::Matrix phase_table(const tsi::RealVector& taus, int n_x) {
+    tsi::Matrix phases(n_x / 2 + 1, taus.size());
     for (Index j = 0; j < taus.size(); ++j) {
       const Complex z = std::polar(1.0, -taus(j)), z2 = z * z;
       Complex phase = 1.0, factor = z;  // e^{-i m^2 tau}, e^{-i (2m+1) tau}
-      t.phases(0, j) = 1.0;
-      for (int m = 1; m <= n_x_ / 2; ++m) {
+      phases(0, j) = 1.0;
+      for (int m = 1; m <= n_x / 2; ++m) {
         phase *= factor;
         factor *= z2;
-        t.phases(m, j) = phase;
+        phases(m, j) = phase;
       }
     }
-    return t.phases;
+    return phases;
   }
 
   // a b and a conj(b), written out: std::complex's operator* tests every product for inf/NaN.
@@ -265,15 +275,8 @@ class Nls final : public tsi::Model {
     return {a.real() * b.real() + a.imag() * b.imag(), a.imag() * b.real() - a.real() * b.imag()};
   }
 
-  struct PhaseTable {
-    tsi::RealVector taus;
-    tsi::Matrix phases;
-  };
-
   int n_x_;
   tsi::RealVector wave_numbers_;
-  mutable std::array<PhaseTable, 2> phase_tables_;
-  mutable size_t next_table_ = 0;
   mutable std::mutex mutex_;  // the batches' buffers are shared work space
   mutable std::map<Index, std::unique_ptr<XBatch>> batches_;
 };
