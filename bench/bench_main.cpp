@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <string>
 
+#include "tsi/assembly.hpp"
 #include "tsi/fft.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/plugin_loader.hpp"
@@ -88,12 +89,17 @@ void fft_bound(benchmark::State& state, Case c) {
 }
 
 void step(benchmark::State& state, Case c, std::string scheme, double eps) {
-  const auto& s = registry().scheme(scheme);
-  auto model = make_model(c, eps);
-  auto problem = two_scale(model, c, std::max(1, s.traits.initial_data_order));
-  tsi::Json params = tsi::resolve_params(s.info.params, tsi::Json::object(), "bench");
-  auto stepper = s.create(tsi::Params(params));
-  const tsi::Vector y0 = problem->prepare(model->initial_value());
+  // The runner's assembler: every default completed as `tsi run` completes it (SE2's nodes).
+  tsi::Json model_section = c.model_params;
+  model_section["name"] = c.model;
+  model_section["eps"] = eps;
+  tsi::Assembly a = tsi::assemble_config({{"model", model_section},
+                                          {"reformulation", {{"name", "two-scale"}, {"n_tau", c.n_tau}}},
+                                          {"scheme", {{"name", scheme}}}},
+                                         registry());
+  tsi::Reformulation* problem = a.reformulation.get();
+  tsi::Stepper* stepper = a.stepper.get();
+  const tsi::Vector y0 = problem->prepare(a.u0);
   tsi::Vector y = y0;
   const double h = 0.125;
   long n = 0;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include "tsi/assembly.hpp"
 #include "tsi/error.hpp"
 
 namespace tsi::app {
@@ -26,22 +27,6 @@ const Json& section_object(const Json& raw, const std::string& key, const Json& 
   const Json& s = raw.at(key);
   if (!s.is_object()) throw ConfigError(key, "got " + s.dump() + ", expected an object");
   return s;
-}
-
-std::string name_of(const Json& section, const std::string& key, const std::string& fallback) {
-  if (!section.contains("name")) {
-    if (fallback.empty()) throw ConfigError(key + ".name", "missing; it names the " + key + " to use");
-    return fallback;
-  }
-  const Json& n = section.at("name");
-  if (!n.is_string()) throw ConfigError(key + ".name", "got " + n.dump() + ", expected a string");
-  return n.get<std::string>();
-}
-
-Json with_name(const std::string& name, const Json& params) {
-  Json out = {{"name", name}};
-  out.update(params);
-  return out;
 }
 
 const ParamSchema& time_schema() {
@@ -145,35 +130,7 @@ Json resolve_run_config(const Json& raw, const Registry& registry) {
       throw ConfigError(key, "unknown section; valid sections are: " + join(sections));
 
   const Json empty = Json::object();
-  Json out;
-
-  const Json& model = section_object(raw, "model", empty);
-  const ModelEntry& model_entry = registry.model(name_of(model, "model", ""));
-  out["model"] = with_name(model_entry.info.name,
-                           resolve_params(model_entry.info.params, without_name(model), "model"));
-
-  const Json& scheme = section_object(raw, "scheme", empty);
-  const SchemeEntry& scheme_entry = registry.scheme(name_of(scheme, "scheme", "se1"));
-  Json sparams = resolve_params(scheme_entry.info.params, without_name(scheme), "scheme");
-  if (sparams.contains("quadrature_nodes") && sparams["quadrature_nodes"].is_null())
-    sparams["quadrature_nodes"] = default_quadrature_nodes(model_entry);
-  out["scheme"] = with_name(scheme_entry.info.name, sparams);
-
-  const Json& reformulation = section_object(raw, "reformulation", empty);
-  const auto& supported = scheme_entry.traits.reformulations;
-  const std::string default_reformulation =
-      std::find(supported.begin(), supported.end(), "two-scale") != supported.end() || supported.empty()
-          ? "two-scale"
-          : supported.front();
-  const ReformulationEntry& reformulation_entry =
-      registry.reformulation(name_of(reformulation, "reformulation", default_reformulation));
-  registry.check_compatible(scheme_entry, reformulation_entry);
-  Json rparams = resolve_params(reformulation_entry.info.params, without_name(reformulation),
-                                "reformulation");
-  if (rparams.contains("n_tau") && rparams["n_tau"].is_null()) rparams["n_tau"] = model_entry.default_n_tau;
-  if (rparams.contains("initial_data_order") && rparams["initial_data_order"].is_null())
-    rparams["initial_data_order"] = std::max(1, scheme_entry.traits.initial_data_order);
-  out["reformulation"] = with_name(reformulation_entry.info.name, rparams);
+  Json out = resolve_selection(raw, registry);  // model, reformulation, scheme: the core's assembler
 
   out["time"] = resolve_params(time_schema(), section_object(raw, "time", empty), "time");
   step_count(out);  // t_end must be a whole number of steps

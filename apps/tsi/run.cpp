@@ -9,6 +9,7 @@
 
 #include "config.hpp"
 #include "run_recorder.hpp"
+#include "tsi/assembly.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/driver.hpp"
 #include "tsi/error.hpp"
@@ -23,60 +24,31 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-Vector initial_value(const Model& model, const Json& model_config) {
-  if (!model_config.contains("u0") || model_config["u0"].is_null()) return model.initial_value();
-  const Json& u0 = model_config["u0"];
-  if (static_cast<Index>(u0.size()) != model.dim())
-    throw ConfigError("model.u0", fmt::format("got {} entries, expected {} (the model's dimension)",
-                                              u0.size(), model.dim()));
-  Vector x(model.dim());
-  for (Index i = 0; i < model.dim(); ++i) {
-    const Json& v = u0[static_cast<size_t>(i)];
-    if (v.is_number())
-      x(i) = v.get<double>();
-    else if (v.is_array() && v.size() == 2 && v[0].is_number() && v[1].is_number()) {
-      if (!model.is_complex() && v[1].get<double>() != 0.0)
-        throw ConfigError(fmt::format("model.u0[{}]", i),
-                          "got " + v.dump() + ", expected a real number (this model's state is real)");
-      x(i) = Complex(v[0].get<double>(), v[1].get<double>());
-    }
-    else
-      throw ConfigError(fmt::format("model.u0[{}]", i), "got " + v.dump() + ", expected a number or [re, im]");
-  }
-  return model.from_physical(x);
-}
-
 // The reference's final state in model variables, with its scheme's tolerance scaled by
 // `tol_factor` and its substeps per fast period by `substep_factor`.
 Vector reference_model_state(const Json& config, const Registry& registry, double tol_factor, double substep_factor) {
   const Json& ref = config["reference"];
   const SchemeEntry& scheme = registry.scheme(ref["scheme"], "reference.scheme");
-  const ReformulationEntry& reform = registry.reformulation(ref["reformulation"], "reference.reformulation");
-  std::shared_ptr<const Model> model =
-      registry.model(config["model"]["name"]).create(Params(without_name(config["model"])));
-  Json scheme_params = Json::object();
+  Json scheme_section = {{"name", scheme.info.name}};
   for (const auto& spec : scheme.info.params) {
-    if (spec.name == "tol") scheme_params["tol"] = std::max(1e-16, ref["tol"].get<double>() * tol_factor);
+    if (spec.name == "tol") scheme_section["tol"] = std::max(1e-16, ref["tol"].get<double>() * tol_factor);
     if (spec.name == "substeps_per_period")
-      scheme_params["substeps_per_period"] = spec.default_value.get<double>() * substep_factor;
+      scheme_section["substeps_per_period"] = spec.default_value.get<double>() * substep_factor;
   }
-  // A two-scale reference gets the model's own tau resolution and the data its scheme needs.
-  Json reform_params = Json::object();
-  for (const auto& spec : reform.info.params) {
-    if (spec.name == "n_tau") reform_params["n_tau"] = registry.model(config["model"]["name"]).default_n_tau;
-    if (spec.name == "initial_data_order")
-      reform_params["initial_data_order"] = std::max(1, scheme.traits.initial_data_order);
-  }
-  auto reformulation = reform.create(model, Params(resolve_params(reform.info.params, reform_params, "reference")));
-  auto stepper = scheme.create(Params(resolve_params(scheme.info.params, scheme_params, "reference")));
+  // The same assembler as the run's: a two-scale reference gets the model's own tau
+  // resolution and the data its scheme needs.
+  Assembly a = assemble_config({{"model", config["model"]},
+                                {"reformulation", {{"name", ref["reformulation"]}}},
+                                {"scheme", scheme_section}},
+                               registry);
   const double t_end = config["time"]["t_end"];
-  Vector y = reformulation->prepare(initial_value(*model, config["model"]));
+  Vector y = a.reformulation->prepare(a.u0);
   if (t_end > 0.0) {
     const double h = ref["h"].is_null() ? t_end : ref["h"].get<double>() / substep_factor;
     const long steps = std::max(1L, std::lround(t_end / h));
-    integrate(*reformulation, *stepper, y, t_end / static_cast<double>(steps), steps, {});
+    integrate(*a.reformulation, *a.stepper, y, t_end / static_cast<double>(steps), steps, {});
   }
-  return reformulation->read_back(y, t_end);
+  return a.reformulation->read_back(y, t_end);
 }
 
 // The relative error in physical variables that rounding the model state u alone causes:
@@ -137,13 +109,12 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   const auto start = Clock::now();
   // Construction: bad input (a model's own checks, u0 of the wrong shape) is a ConfigError
   // that propagates before anything runs.
-  const ModelEntry& model_entry = registry.model(config["model"]["name"]);
-  const SchemeEntry& scheme_entry = registry.scheme(config["scheme"]["name"]);
-  const ReformulationEntry& reform_entry = registry.reformulation(config["reformulation"]["name"]);
-  std::shared_ptr<const Model> model = model_entry.create(Params(without_name(config["model"])));
-  const Vector u0 = initial_value(*model, config["model"]);
-  auto reformulation = reform_entry.create(model, Params(without_name(config["reformulation"])));
-  auto stepper = scheme_entry.create(Params(without_name(config["scheme"])));
+  Assembly assembly = assemble(config, registry);
+  const SchemeEntry& scheme_entry = *assembly.scheme_entry;
+  std::shared_ptr<const Model> model = assembly.model;
+  const Vector u0 = assembly.u0;
+  Reformulation* reformulation = assembly.reformulation.get();
+  Stepper* stepper = assembly.stepper.get();
 
   const auto& rconf = config["reformulation"];
   if (rconf.contains("initial_data_order") &&

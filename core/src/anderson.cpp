@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "tsi/algebra.hpp"
+
 namespace tsi {
 namespace {
 constexpr int max_depth = 8;
@@ -14,31 +16,26 @@ AndersonSolver::AndersonSolver(FixedPointOptions options)
     : FixedPointSolver(options), depth_(std::clamp(options.anderson_depth, 1, max_depth)) {}
 
 int AndersonSolver::iterate(Vector& x, FixedPointMap g, double& increment) {
-  const Index n = x.size();
-  if (residual_diffs_.rows() != n) {
-    gx_.resize(n), residual_.resize(n), residual_prev_.resize(n), gx_prev_.resize(n);
-    residual_diffs_.resize(n, depth_), map_diffs_.resize(n, depth_);
-  }
+  if (residual_diffs_.size() != static_cast<size_t>(depth_)) residual_diffs_.resize(depth_), map_diffs_.resize(depth_);
   int stored = 0, next_column = 0;
   for (int k = 1; k <= options().max_iter; ++k) {
     g(x, gx_);
-    residual_ = gx_ - x;
-    const double scale = max_norm(gx_);
-    increment = max_norm(residual_) / (scale > 0.0 ? scale : 1.0);
+    algebra::axpby(1.0, gx_, -1.0, x, residual_);
+    increment = algebra::relative_increment(gx_, x);
     if (increment <= options().tol) {
-      x = gx_;
+      algebra::copy(gx_, x);
       return k;
     }
     if (k > 1) {
-      residual_diffs_.col(next_column) = residual_ - residual_prev_;
-      map_diffs_.col(next_column) = gx_ - gx_prev_;
+      algebra::axpby(1.0, residual_, -1.0, residual_prev_, residual_diffs_[next_column]);
+      algebra::axpby(1.0, gx_, -1.0, gx_prev_, map_diffs_[next_column]);
       next_column = (next_column + 1) % depth_;
       stored = std::min(stored + 1, depth_);
     }
-    residual_prev_ = residual_;
-    gx_prev_ = gx_;
+    algebra::copy(residual_, residual_prev_);
+    algebra::copy(gx_, gx_prev_);
     if (stored == 0) {
-      x = gx_;
+      algebra::copy(gx_, x);
       continue;
     }
     // gamma = argmin |residual - D gamma| over real gamma: normal equations, lightly
@@ -46,14 +43,13 @@ int AndersonSolver::iterate(Vector& x, FixedPointMap g, double& increment) {
     SmallMatrix gram(stored, stored);
     SmallVector rhs(stored);
     for (int i = 0; i < stored; ++i) {
-      rhs(i) = residual_diffs_.col(i).dot(residual_).real();
-      for (int j = 0; j <= i; ++j)
-        gram(i, j) = gram(j, i) = residual_diffs_.col(i).dot(residual_diffs_.col(j)).real();
+      rhs(i) = algebra::inner(residual_diffs_[i], residual_);
+      for (int j = 0; j <= i; ++j) gram(i, j) = gram(j, i) = algebra::inner(residual_diffs_[i], residual_diffs_[j]);
     }
     gram.diagonal().array() += 1e-13 * gram.diagonal().maxCoeff();
     const SmallVector gamma = gram.ldlt().solve(rhs);
-    x = gx_;
-    for (int i = 0; i < stored; ++i) x -= gamma(i) * map_diffs_.col(i);
+    algebra::copy(gx_, x);
+    for (int i = 0; i < stored; ++i) algebra::axpy(-gamma(i), map_diffs_[i], x);
   }
   return -1;
 }

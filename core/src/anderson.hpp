@@ -1,4 +1,6 @@
 #pragma once
+#include <vector>
+
 #include "tsi/fixed_point.hpp"
 
 namespace tsi {
@@ -17,7 +19,7 @@ class AndersonSolver final : public FixedPointSolver {
  private:
   int depth_;
   Vector gx_, residual_, residual_prev_, gx_prev_;
-  Matrix residual_diffs_, map_diffs_;  // one column per stored difference
+  std::vector<Vector> residual_diffs_, map_diffs_;  // a ring of the last depth_ differences
 };
 
 }  // namespace tsi

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <memory>
 
 #include "reformulations/direct.hpp"
@@ -29,6 +30,10 @@ void register_core(Registry& registry) {
            .check([](const Json& v) { return v.get<long>() >= 1 && v.get<long>() <= 3; },
                   "1, 2 or 3")},
       ""};
+  two_scale.complete = [](Json& p, const Selection& s) {
+    if (p["n_tau"].is_null()) p["n_tau"] = s.model.default_n_tau;
+    if (p["initial_data_order"].is_null()) p["initial_data_order"] = std::max(1, s.scheme.traits.initial_data_order);
+  };
   two_scale.create = [](std::shared_ptr<const Model> model, const Params& p) {
     const int n_tau = p.has("n_tau") ? static_cast<int>(p.integer("n_tau")) : 64;
     const int order = p.has("initial_data_order") ? static_cast<int>(p.integer("initial_data_order")) : 2;

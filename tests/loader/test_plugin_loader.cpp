@@ -91,7 +91,7 @@ TEST_CASE("loader: the layout handshake covers the exchanged structures") {
   CHECK(layout.entry_info.size == sizeof(tsi::EntryInfo));
   CHECK(layout.entry_info.align == alignof(tsi::EntryInfo));
   CHECK(layout.eigen_max_align_bytes == EIGEN_MAX_ALIGN_BYTES);
-  CHECK(TSI_PLUGIN_ABI_VERSION == 4);  // 4: the remainder, bind_tau_grid, invariants, entry completion
+  CHECK(TSI_PLUGIN_ABI_VERSION == 5);  // 4: the remainder, bind_tau_grid, invariants; 5: entry completion, needs_exact_flows
 }
 
 TEST_CASE("loader: a plugin for another tsi major version is refused") {

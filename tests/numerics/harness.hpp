@@ -1,12 +1,14 @@
 #pragma once
-// Builds models, reformulations and schemes from the shipped plugins, as the runner does,
-// for tests that drive the numerics directly.
+// Builds models, reformulations and schemes from the shipped plugins through the core's
+// assembler (tsi::assemble_config, as `tsi run`, `tsi check` and the benchmarks do), for tests
+// that drive the numerics directly.
 #include <algorithm>
 #include <map>
 #include <memory>
 #include <string>
 #include <tuple>
 
+#include "tsi/assembly.hpp"
 #include "tsi/driver.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/plugin_loader.hpp"
@@ -20,6 +22,10 @@ class Harness {
     static Harness harness;
     return harness;
   }
+
+  /// A run's objects from a config's model, reformulation and scheme sections, every default
+  /// completed by the selected entries (the model's n_tau, the scheme's data order, SE2's nodes).
+  Assembly assemble(const Json& config) const { return assemble_config(config, registry_); }
 
   std::shared_ptr<const Model> model(const std::string& name, double eps) const {
     return model_with(name, eps, Json::object());
@@ -37,9 +43,15 @@ class Harness {
     return e.create(std::move(m), Params(resolve_params(e.info.params, params, "reformulation")));
   }
 
-  std::unique_ptr<Stepper> scheme(const std::string& name, const Json& params = Json::object()) const {
+  /// A scheme, its parameters completed for `model` on the two-scale reformulation (SE2's
+  /// nodes depend on the model: without a model it refuses to guess).
+  std::unique_ptr<Stepper> scheme(const std::string& name, const Json& params = Json::object(),
+                                  const std::string& model = "") const {
     const auto& e = registry_.scheme(name);
-    return e.create(Params(resolve_params(e.info.params, params, "scheme")));
+    Json resolved = resolve_params(e.info.params, params, "scheme");
+    if (e.complete && !model.empty())
+      e.complete(resolved, Selection{registry_.model(model), registry_.reformulation("two-scale"), e});
+    return e.create(Params(resolved));
   }
 
   const Registry& registry() const { return registry_; }

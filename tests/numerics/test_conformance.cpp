@@ -25,7 +25,7 @@ double error_at_one(const tsi::SchemeEntry& scheme, double eps, long steps) {
   tsi::Json params = tsi::Json::object();
   for (const auto& p : scheme.info.params)
     if (p.name == "tol") params["tol"] = 1e-12;
-  auto stepper = h.scheme(scheme.info.name, params);
+  auto stepper = h.scheme(scheme.info.name, params, "henon-heiles");
   const Vector& ref = tsi::test::reference_solution("henon-heiles", eps, 1.0);
   return (tsi::test::solve(*model, *two_scale, *stepper, 1.0, steps) - ref).norm() / ref.norm();
 }
@@ -89,7 +89,7 @@ TEST_CASE("conformance: a step h then -h returns the state exactly when the sche
           if (p.name == "tol") params["tol"] = 1e-15;
           if (p.name == "max_iter") params["max_iter"] = 1000;
         }
-        auto stepper = h.scheme(scheme->info.name, params);
+        auto stepper = h.scheme(scheme->info.name, params, c.model);
         const Vector start = two_scale->prepare(model->initial_value());
         Vector y = start;
         stepper->reset();

@@ -86,7 +86,7 @@ double cpd_error(const tsi::SchemeEntry& scheme, double eps, long steps) {
   tsi::Json params = tsi::Json::object();
   for (const auto& p : scheme.info.params)
     if (p.name == "tol") params["tol"] = 1e-12;
-  auto stepper = h.scheme(scheme.info.name, params);
+  auto stepper = h.scheme(scheme.info.name, params, "cpd");
   return relative(tsi::test::solve(*model, *two_scale, *stepper, 1.0, steps),
                   tsi::test::reference_solution("cpd", eps, 1.0));
 }
@@ -265,7 +265,7 @@ TEST_CASE("cpd: over T = 200 at eps = 0.5, SE1 keeps the energy error small whil
     const auto& entry = h.registry().scheme(name);
     auto two_scale = h.reformulation(
         "two-scale", model, {{"n_tau", 64}, {"initial_data_order", entry.traits.initial_data_order}});
-    auto stepper = h.scheme(name);
+    auto stepper = h.scheme(name, tsi::Json::object(), "cpd");
     Vector y = two_scale->prepare(u0);
     double err_H = 0.0;
     tsi::integrate(*two_scale, *stepper, y, 0.2, 1000, [&](long, double t, const Vector& state) {

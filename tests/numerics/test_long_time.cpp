@@ -23,7 +23,7 @@ EnergyRecord energy_error(const tsi::SchemeEntry& scheme) {
   auto model = h.model("henon-heiles", 0.01);
   auto two_scale = h.reformulation("two-scale", model,
                                    {{"n_tau", 64}, {"initial_data_order", std::max(1, scheme.traits.initial_data_order)}});
-  auto stepper = h.scheme(scheme.info.name);
+  auto stepper = h.scheme(scheme.info.name, tsi::Json::object(), "henon-heiles");
   const Vector u0 = model->initial_value();
   const double H0 = model->energy(u0);
   Vector y = two_scale->prepare(u0);

@@ -75,7 +75,7 @@ double nls_error(const tsi::SchemeEntry& scheme, double eps, long steps) {
   auto two_scale = h.reformulation(
       "two-scale", model,
       {{"n_tau", 256}, {"initial_data_order", std::max(1, scheme.traits.initial_data_order)}});
-  auto stepper = h.scheme(scheme.info.name, tight(scheme));
+  auto stepper = h.scheme(scheme.info.name, tight(scheme), "nls");
   const Vector& ref = tsi::test::reference_solution("nls", eps, 1.0);
   return model->error_norm(tsi::test::solve(*model, *two_scale, *stepper, 1.0, steps) - ref) /
          model->error_norm(ref);
@@ -257,7 +257,7 @@ TEST_CASE("nls: symmetric schemes nearly conserve mass and energy over T = 200, 
     const auto& entry = h.registry().scheme(name);
     auto two_scale = h.reformulation(
         "two-scale", model, {{"n_tau", 256}, {"initial_data_order", entry.traits.initial_data_order}});
-    auto stepper = h.scheme(name);
+    auto stepper = h.scheme(name, tsi::Json::object(), "nls");
     Vector y = two_scale->prepare(u0);
     double err_m = 0.0, err_H = 0.0, err_m_half = 0.0;
     tsi::integrate(*two_scale, *stepper, y, 0.2, 1000, [&](long n, double t, const Vector& state) {

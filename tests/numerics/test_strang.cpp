@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include "harness.hpp"
 #include "runner/run_command.hpp"
@@ -90,34 +91,37 @@ TEST_CASE("strang: a step with h then -h returns the state") {
   }
 }
 
-TEST_CASE("strang: refuses a problem without exact flows") {
+TEST_CASE("strang: refuses a problem without exact flows before anything runs") {
   auto& h = Harness::instance();
-  // Henon-Heiles has no exact nonlinear flow: a clear error at the first step.
-  auto model = h.model("henon-heiles", 0.1);
-  auto direct = h.reformulation("direct", model);
-  auto strang = h.scheme("strang");
-  Vector y = model->initial_value();
-  CHECK_THROWS_WITH_AS(strang->step(*direct, 0.0, 0.1, y), doctest::Contains("exact nonlinear flow"),
-                       tsi::Error);
-  // The other reformulations are refused before anything runs.
+  // Henon-Heiles has no exact nonlinear flow: the assembler refuses the pairing, naming both.
+  const tsi::Json selection = {{"model", {{"name", "henon-heiles"}, {"eps", 0.1}}},
+                               {"reformulation", {{"name", "direct"}}},
+                               {"scheme", {{"name", "strang"}}}};
+  CHECK_THROWS_WITH_AS(h.assemble(selection),
+                       doctest::Contains("scheme \"strang\" needs the exact linear and nonlinear flows, which "
+                                         "model \"henon-heiles\" on the \"direct\" reformulation"),
+                       tsi::ConfigError);
+  // NLS has one: the same selection assembles.
+  tsi::Json nls = selection;
+  nls["model"] = {{"name", "nls"}, {"eps", 0.1}};
+  CHECK(h.assemble(nls).stepper != nullptr);
+  // The other reformulations are refused by the registry's compatibility check.
   const auto& registry = h.registry();
   CHECK_THROWS_AS(registry.check_compatible(registry.scheme("strang"), registry.reformulation("two-scale")),
                   tsi::ConfigError);
   CHECK_THROWS_AS(registry.check_compatible(registry.scheme("strang"), registry.reformulation("filtered")),
                   tsi::ConfigError);
 
-  // From the runner: Henon-Heiles with strang fails at the start with that message (exit 1);
-  // strang on two-scale is bad input (exit 2).
+  // From the runner both are bad input (exit 2, the field named), and nothing is computed.
   const tsi::test::TempDir dir("tsi-strang");
   tsi::Json config = tsi::test::small_config();
   config["scheme"] = {{"name", "strang"}};
   config["reformulation"] = {{"name", "direct"}};
   const auto hh = tsi::test::run_tsi({"run", tsi::test::write_config(dir, config), "--out", dir / "hh"});
-  CHECK(hh.exit_code == 1);
-  CHECK(tsi::test::contains(hh.out + hh.err, "exact nonlinear flow"));
-  const auto result = tsi::test::read_json(dir.path() / "hh" / "result.json");
-  CHECK(result.at("status") == "failed");
-  CHECK(result.at("steps") == 0);
+  CHECK(hh.exit_code == 2);
+  CHECK(tsi::test::contains(hh.err, "scheme.name"));
+  CHECK(tsi::test::contains(hh.err, "henon-heiles"));
+  CHECK_FALSE(std::filesystem::exists(dir.path() / "hh" / "result.json"));
   config["model"] = {{"name", "nls"}, {"eps", 0.1}};
   config["reformulation"] = {{"name", "two-scale"}};
   const auto two_scale =

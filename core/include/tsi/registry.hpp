@@ -27,6 +27,22 @@ using ReformulationFactory =
     std::function<std::unique_ptr<Reformulation>(std::shared_ptr<const Model>, const Params&)>;
 using StepperFactory = std::function<std::unique_ptr<Stepper>(const Params&)>;
 
+struct ModelEntry;
+struct ReformulationEntry;
+struct SchemeEntry;
+
+/// What a config selects: the three registered entries a run is assembled from.
+struct TSI_API Selection {
+  const ModelEntry& model;
+  const ReformulationEntry& reformulation;
+  const SchemeEntry& scheme;
+};
+
+/// Completes an entry's resolved parameters from the selection: sets the ones its schema left
+/// null (optional, no fixed default) to what this model and scheme need. Runs after the
+/// schema check, before anything is built.
+using CompleteFn = std::function<void(Json& params, const Selection& selection)>;
+
 struct TSI_API ModelEntry {
   EntryInfo info;
   int default_n_tau = 64;  ///< tau resolution for the two-scale reformulation (SPEC.md sec. 4)
@@ -39,20 +55,20 @@ struct TSI_API ModelEntry {
 struct TSI_API ReformulationEntry {
   EntryInfo info;
   ReformulationFactory create;
+  CompleteFn complete;  ///< optional (two-scale: n_tau from the model, data order from the scheme)
 };
 
 struct TSI_API SchemeEntry {
   EntryInfo info;
   StepperTraits traits;
   StepperFactory create;
+  CompleteFn complete;  ///< optional (SE2: quadrature nodes from the model's nonlinearity)
 };
 
 /// The runtime registry of models, reformulations and schemes (PETSc TSRegister / OpenFOAM
 /// runtime selection). Look-ups accept names and aliases; a miss lists the valid names.
 class TSI_API Registry {
  public:
-  enum class Kind { Model, Reformulation, Scheme };
-
   /// The process-wide registry that the runner and all plugins share.
   static Registry& global();
 

@@ -15,7 +15,8 @@ struct TSI_API StepperTraits {
   bool implicit = false;                 ///< has implicit stages (fixed-point iteration)
   bool multistep = false;                ///< needs a start-up; reset() starts a new trajectory
   bool adaptive = false;                 ///< chooses its own substeps inside step()
-  bool needs_diagonal_linear_part = false;
+  bool needs_diagonal_linear_part = false;  ///< uses Problem::linear_multipliers (exponential schemes)
+  bool needs_exact_flows = false;        ///< uses Problem::linear_flow and nonlinear_flow (splitting)
   int initial_data_order = 1;            ///< two-scale prepared data needed for uniform order
   std::vector<std::string> reformulations;  ///< the reformulations it can integrate
 };

@@ -6,11 +6,13 @@
 #include <limits>
 #include <memory>
 
+#include "tsi/algebra.hpp"
 #include "tsi/diagonal.hpp"
 #include "tsi/plugin.hpp"
 
 namespace {
 
+namespace algebra = tsi::algebra;
 using tsi::Complex;
 using tsi::Vector;
 
@@ -18,21 +20,24 @@ class Fd final : public tsi::Stepper {
  public:
   void step(tsi::Problem& problem, double t, double h, Vector& y) override {
     if (h != h_ || problem.size() != inverse_.size()) {
-      tsi::diagonal_function(problem.linear_multipliers(), 0.5 * h,
-                             [](Complex z) { return 1.0 / (1.0 - z); }, inverse_);
-      tsi::diagonal_function(problem.linear_multipliers(), 0.5 * h,
-                             [](Complex z) { return 1.0 + z; }, forward_);
+      const Vector& lambda = problem.linear_multipliers();
+      tsi::diagonal_function(lambda, 0.5 * h, [](Complex z) { return 1.0 / (1.0 - z); }, inverse_);
+      tsi::diagonal_function(lambda, 0.5 * h, [h](Complex z) { return 0.5 * h / (1.0 - z); }, half_inverse_);
+      tsi::diagonal_function(lambda, 0.5 * h, [](Complex z) { return (1.0 + z) / (1.0 - z); }, cayley_);
+      tsi::diagonal_function(lambda, 0.5 * h, [h](Complex z) { return h / (1.0 - z); }, full_inverse_);
       h_ = h;
     }
     problem.nonlinear(t, y, n_);
-    half_ = inverse_.cwiseProduct(y + (0.5 * h) * n_);
+    algebra::diagonal_combination(inverse_, y, half_inverse_, n_, half_);
     problem.nonlinear(t + 0.5 * h, half_, n_);
-    y = inverse_.cwiseProduct(forward_.cwiseProduct(y) + h * n_);
+    algebra::diagonal_combination(cayley_, y, full_inverse_, n_, y);
   }
 
  private:
   double h_ = std::numeric_limits<double>::quiet_NaN();
-  Vector inverse_, forward_, half_, n_;  // (1 - hL/2)^{-1}, (1 + hL/2)
+  // (1 - hL/2)^{-1}, (h/2) (1 - hL/2)^{-1}, (1 + hL/2) (1 - hL/2)^{-1}, h (1 - hL/2)^{-1}
+  Vector inverse_, half_inverse_, cayley_, full_inverse_;
+  Vector half_, n_;
 };
 
 void register_fd(tsi::Registry& registry) {

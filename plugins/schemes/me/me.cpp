@@ -5,12 +5,14 @@
 #include <limits>
 #include <memory>
 
+#include "tsi/algebra.hpp"
 #include "tsi/diagonal.hpp"
 #include "tsi/phi.hpp"
 #include "tsi/plugin.hpp"
 
 namespace {
 
+namespace algebra = tsi::algebra;
 using tsi::Complex;
 using tsi::Vector;
 
@@ -24,16 +26,19 @@ class Me final : public tsi::Stepper {
       tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_);
       tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi1(z); }, p1_);
       tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi2(z); }, p2_);
+      p12_ = p1_ + p2_;
+      minus_p2_ = -p2_;
       has_previous_ = false;  // the two-step formula assumes a constant step: start again
       h_ = h;
     }
     problem.nonlinear(t, y, n_);
     if (has_previous_) {
-      y = e_.cwiseProduct(y) + p1_.cwiseProduct(n_) + p2_.cwiseProduct(n_ - previous_);
+      algebra::diagonal_combination(e_, y, p12_, n_, minus_p2_, previous_, y);
     } else {  // the start-up step
-      star_ = e_.cwiseProduct(y) + p1_.cwiseProduct(n_);
+      algebra::diagonal_combination(e_, y, p1_, n_, star_);
       problem.nonlinear(t + h, star_, n_star_);
-      y = star_ + p2_.cwiseProduct(n_star_ - n_);
+      algebra::axpby(1.0, n_star_, -1.0, n_, n_star_);
+      algebra::diagonal_multiply_add(star_, p2_, n_star_, y);
     }
     previous_.swap(n_);
     has_previous_ = true;
@@ -42,7 +47,7 @@ class Me final : public tsi::Stepper {
  private:
   double h_ = std::numeric_limits<double>::quiet_NaN();
   bool has_previous_ = false;
-  Vector e_, p1_, p2_, n_, previous_, star_, n_star_;
+  Vector e_, p1_, p2_, p12_, minus_p2_, n_, previous_, star_, n_star_;  // p12 = p1 + p2
 };
 
 void register_me(tsi::Registry& registry) {

@@ -5,12 +5,14 @@
 #include <limits>
 #include <memory>
 
+#include "tsi/algebra.hpp"
 #include "tsi/fixed_point.hpp"
 #include "tsi/phi.hpp"
 #include "tsi/plugin.hpp"
 
 namespace {
 
+namespace algebra = tsi::algebra;
 using tsi::Vector;
 
 class Se1 final : public tsi::Stepper {
@@ -22,19 +24,19 @@ class Se1 final : public tsi::Stepper {
 
   void step(tsi::Problem& problem, double t, double h, Vector& y) override {
     if (h != h_ || problem.size() != y_half_.size()) prepare(problem, h);
-    base_half_ = e_half_.cwiseProduct(y);
+    algebra::diagonal_multiply(e_half_, y, base_half_);
     // Starting guess: the stage with the previous step's N(U^{n-1/2}), an O(h^2) predictor.
     if (guess_previous_ && have_previous_)
-      y_half_ = base_half_ + b_half_.cwiseProduct(n_half_);
+      algebra::diagonal_multiply_add(base_half_, b_half_, n_half_, y_half_);
     else
-      y_half_ = base_half_;
+      algebra::copy(base_half_, y_half_);
     const double t_half = t + 0.5 * h;
     solver_->solve(y_half_, [&](const Vector& x, Vector& out) {
       problem.nonlinear(t_half, x, n_half_);
-      out = base_half_ + b_half_.cwiseProduct(n_half_);
+      algebra::diagonal_multiply_add(base_half_, b_half_, n_half_, out);
     });
     // n_half_ = N at the last-but-one iterate, within tol of N(U^{n+1/2}).
-    y = e_full_.cwiseProduct(y) + b_full_.cwiseProduct(n_half_);
+    algebra::diagonal_combination(e_full_, y, b_full_, n_half_, y);
     have_previous_ = true;
   }
 

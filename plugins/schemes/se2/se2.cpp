@@ -5,7 +5,9 @@
 #include <limits>
 #include <memory>
 
+#include "tsi/algebra.hpp"
 #include "tsi/diagonal.hpp"
+#include "tsi/error.hpp"
 #include "tsi/fixed_point.hpp"
 #include "tsi/phi.hpp"
 #include "tsi/plugin.hpp"
@@ -13,6 +15,7 @@
 
 namespace {
 
+namespace algebra = tsi::algebra;
 using tsi::Complex;
 using tsi::Vector;
 
@@ -32,23 +35,23 @@ class Se2 final : public tsi::Stepper {
       h_ = h;
       have_previous_ = false;
     }
-    base_ = e_.cwiseProduct(y);
+    algebra::diagonal_multiply(e_, y, base_);
     // Starting guess: the previous step's averaged N, an O(h^2) predictor.
     if (guess_previous_ && have_previous_)
-      next_ = base_ + b_.cwiseProduct(average_);
+      algebra::diagonal_multiply_add(base_, b_, average_, next_);
     else
-      next_ = base_;
+      algebra::copy(base_, next_);
     solver_->solve(next_, [&](const Vector& x, Vector& out) {
-      average_.setZero(y.size());
+      algebra::set_zero(y.size(), average_);
       for (size_t i = 0; i < rule_.nodes.size(); ++i) {
         const double rho = rule_.nodes[i];
-        stage_ = (1.0 - rho) * y + rho * x;
+        algebra::axpby(1.0 - rho, y, rho, x, stage_);
         problem.nonlinear(t + rho * h, stage_, n_);
-        average_ += rule_.weights[i] * n_;
+        algebra::axpy(rule_.weights[i], n_, average_);
       }
-      out = base_ + b_.cwiseProduct(average_);
+      algebra::diagonal_multiply_add(base_, b_, average_, out);
     });
-    y = next_;
+    algebra::copy(next_, y);
     have_previous_ = true;
   }
 
@@ -81,8 +84,15 @@ void register_se2(tsi::Registry& registry) {
   entry.traits.needs_diagonal_linear_part = true;
   entry.traits.initial_data_order = 2;
   entry.traits.reformulations = {"filtered", "two-scale"};
+  entry.complete = [](tsi::Json& p, const tsi::Selection& s) {
+    if (p["quadrature_nodes"].is_null()) p["quadrature_nodes"] = tsi::default_quadrature_nodes(s.model);
+  };
   entry.create = [](const tsi::Params& p) {
-    const int nodes = p.has("quadrature_nodes") ? static_cast<int>(p.integer("quadrature_nodes")) : 2;
+    // No silent default here: the node count depends on the model, which complete() knows.
+    if (!p.has("quadrature_nodes"))
+      throw tsi::ConfigError("scheme.quadrature_nodes",
+                             "not set: build the scheme through tsi::assemble, which completes it from the model");
+    const int nodes = static_cast<int>(p.integer("quadrature_nodes"));
     return std::make_unique<Se2>(tsi::fixed_point_options(p), nodes);
   };
   registry.add_scheme(std::move(entry));

@@ -4,7 +4,6 @@
 // baseline a user would pick when the model's nonlinear part has an exact flow.
 #include <memory>
 
-#include "tsi/error.hpp"
 #include "tsi/plugin.hpp"
 
 namespace {
@@ -14,11 +13,6 @@ using tsi::Vector;
 class Strang final : public tsi::Stepper {
  public:
   void step(tsi::Problem& problem, double t, double h, Vector& y) override {
-    if (!problem.has_exact_flows())
-      throw tsi::Error(
-          "scheme \"strang\" needs the exact linear and nonlinear flows of the problem; this model "
-          "has no exact nonlinear flow (Model::has_exact_nonlinear_flow() is false) or the "
-          "reformulation does not provide them (only \"direct\" does)");
     problem.linear_flow(0.5 * h, y);
     problem.nonlinear_flow(t, h, y);
     problem.linear_flow(0.5 * h, y);
@@ -34,6 +28,7 @@ void register_strang(tsi::Registry& registry) {
       "an exact nonlinear flow: nls, cpd)";
   entry.traits.order = 2;
   entry.traits.symmetric = true;
+  entry.traits.needs_exact_flows = true;  // refused at configuration time without them
   entry.traits.reformulations = {"direct"};
   entry.create = [](const tsi::Params&) { return std::make_unique<Strang>(); };
   registry.add_scheme(std::move(entry));

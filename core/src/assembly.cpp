@@ -1,0 +1,130 @@
+#include "tsi/assembly.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "tsi/error.hpp"
+
+namespace tsi {
+namespace {
+
+const Json& section_object(const Json& config, const std::string& key) {
+  static const Json empty = Json::object();
+  if (!config.contains(key) || config.at(key).is_null()) return empty;
+  const Json& s = config.at(key);
+  if (!s.is_object()) throw ConfigError(key, "got " + s.dump() + ", expected an object");
+  return s;
+}
+
+std::string name_of(const Json& section, const std::string& key, const std::string& fallback) {
+  if (!section.contains("name")) {
+    if (fallback.empty()) throw ConfigError(key + ".name", "missing; it names the " + key + " to use");
+    return fallback;
+  }
+  const Json& n = section.at("name");
+  if (!n.is_string()) throw ConfigError(key + ".name", "got " + n.dump() + ", expected a string");
+  return n.get<std::string>();
+}
+
+Json without_name(const Json& section) {
+  Json out = section;
+  out.erase("name");
+  return out;
+}
+
+Json with_name(const std::string& name, const Json& params) {
+  Json out = {{"name", name}};
+  out.update(params);
+  return out;
+}
+
+bool supports(const SchemeEntry& scheme, const std::string& reformulation) {
+  const auto& r = scheme.traits.reformulations;
+  return std::find(r.begin(), r.end(), reformulation) != r.end();
+}
+
+}  // namespace
+
+Json resolve_selection(const Json& config, const Registry& registry) {
+  if (!config.is_object()) throw ConfigError("config", "got " + config.dump() + ", expected a JSON object");
+  const Json& model = section_object(config, "model");
+  const Json& scheme = section_object(config, "scheme");
+  const Json& reformulation = section_object(config, "reformulation");
+
+  const ModelEntry& model_entry = registry.model(name_of(model, "model", ""));
+  const SchemeEntry& scheme_entry = registry.scheme(name_of(scheme, "scheme", "se1"));
+  const auto& supported = scheme_entry.traits.reformulations;
+  const std::string default_reformulation =
+      supports(scheme_entry, "two-scale") || supported.empty() ? "two-scale" : supported.front();
+  const ReformulationEntry& reformulation_entry =
+      registry.reformulation(name_of(reformulation, "reformulation", default_reformulation));
+  registry.check_compatible(scheme_entry, reformulation_entry);
+
+  const Selection selection{model_entry, reformulation_entry, scheme_entry};
+  Json model_params = resolve_params(model_entry.info.params, without_name(model), "model");
+  Json scheme_params = resolve_params(scheme_entry.info.params, without_name(scheme), "scheme");
+  Json reformulation_params =
+      resolve_params(reformulation_entry.info.params, without_name(reformulation), "reformulation");
+  if (scheme_entry.complete) scheme_entry.complete(scheme_params, selection);
+  if (reformulation_entry.complete) reformulation_entry.complete(reformulation_params, selection);
+  return {{"model", with_name(model_entry.info.name, model_params)},
+          {"reformulation", with_name(reformulation_entry.info.name, reformulation_params)},
+          {"scheme", with_name(scheme_entry.info.name, scheme_params)}};
+}
+
+Vector initial_value(const Model& model, const Json& model_section) {
+  if (!model_section.contains("u0") || model_section["u0"].is_null()) return model.initial_value();
+  const Json& u0 = model_section["u0"];
+  if (!u0.is_array() || static_cast<Index>(u0.size()) != model.dim())
+    throw ConfigError("model.u0", fmt::format("got {} entries, expected {} (the model's dimension)",
+                                              u0.is_array() ? u0.size() : 1, model.dim()));
+  Vector x(model.dim());
+  for (Index i = 0; i < model.dim(); ++i) {
+    const Json& v = u0[static_cast<size_t>(i)];
+    if (v.is_number())
+      x(i) = v.get<double>();
+    else if (v.is_array() && v.size() == 2 && v[0].is_number() && v[1].is_number()) {
+      if (!model.is_complex() && v[1].get<double>() != 0.0)
+        throw ConfigError(fmt::format("model.u0[{}]", i),
+                          "got " + v.dump() + ", expected a real number (this model's state is real)");
+      x(i) = Complex(v[0].get<double>(), v[1].get<double>());
+    } else
+      throw ConfigError(fmt::format("model.u0[{}]", i), "got " + v.dump() + ", expected a number or [re, im]");
+  }
+  return model.from_physical(x);
+}
+
+Assembly assemble(const Json& resolved, const Registry& registry) {
+  Assembly a;
+  a.model_entry = &registry.model(resolved.at("model").at("name"));
+  a.reformulation_entry = &registry.reformulation(resolved.at("reformulation").at("name"));
+  a.scheme_entry = &registry.scheme(resolved.at("scheme").at("name"));
+  a.model = a.model_entry->create(Params(without_name(resolved["model"])));
+  a.u0 = initial_value(*a.model, resolved["model"]);
+  a.reformulation = a.reformulation_entry->create(a.model, Params(without_name(resolved["reformulation"])));
+  const StepperTraits& traits = a.scheme_entry->traits;
+  const std::string pair = fmt::format("model \"{}\" on the \"{}\" reformulation", a.model_entry->info.name,
+                                       a.reformulation_entry->info.name);
+  if (traits.needs_diagonal_linear_part && !a.reformulation->has_diagonal_linear_part())
+    throw ConfigError("scheme.name",
+                      fmt::format("scheme \"{}\" needs a linear part diagonal in the problem's coordinates, which {} "
+                                  "does not have; use a reformulation it supports ({})",
+                                  a.scheme_entry->info.name, pair, fmt::join(traits.reformulations, ", ")));
+  if (traits.needs_exact_flows && !a.reformulation->has_exact_flows())
+    throw ConfigError("scheme.name",
+                      fmt::format("scheme \"{}\" needs the exact linear and nonlinear flows, which {} does not "
+                                  "provide{}",
+                                  a.scheme_entry->info.name, pair,
+                                  a.model->has_exact_nonlinear_flow()
+                                      ? " (only \"direct\" in model variables does)"
+                                      : " (the model has no exact nonlinear flow)"));
+  a.stepper = a.scheme_entry->create(Params(without_name(resolved["scheme"])));
+  return a;
+}
+
+Assembly assemble_config(const Json& config, const Registry& registry) {
+  return assemble(resolve_selection(config, registry), registry);
+}
+
+}  // namespace tsi
