@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <set>
 
+#include "tsi/assembly.hpp"
 #include "tsi/convergence.hpp"
 #include "tsi/driver.hpp"
 #include "tsi/error.hpp"
@@ -17,10 +18,6 @@ namespace tsi::app {
 namespace {
 
 constexpr double t_end = 1.0;
-constexpr long step_counts[] = {4, 8, 16, 32};  // h = 1/4 .. 1/32
-// When the order over h = 1/4 .. 1/32 misses, the steps are still pre-asymptotic for this
-// model if the order over h = 1/16 .. 1/128 settles: that fit counts then.
-constexpr long finer_step_counts[] = {16, 32, 64, 128};
 constexpr double reference_tol = 1e-12;
 constexpr double order_margin = 0.2;
 constexpr double symmetry_step = 0.25, symmetry_limit = 1e-10;
@@ -45,12 +42,12 @@ Vector sample_state(const Model& model, const Vector& u0, double phase) {
   return w;
 }
 
-/// The steps h = 1/4 .. 1/32 that lie close to a whole number of half fast periods (pi eps),
-/// within 0.06 of one, as "h = 1/16, h = 1/32 are" (empty when none).
-std::string resonant_steps(double eps) {
+/// The steps that lie close to a whole number of half fast periods (pi eps), within 0.06 of
+/// one, as "h = 1/16, h = 1/32 are" (empty when none).
+std::string resonant_steps(const std::vector<long>& steps, double eps) {
   std::string out;
   int count = 0;
-  for (const long n : step_counts) {
+  for (const long n : steps) {
     const double half_periods = 1.0 / (static_cast<double>(n) * 0.5 * two_pi * eps);
     const double nearest = std::round(half_periods);
     if (nearest >= 1.0 && std::abs(half_periods - nearest) <= 0.06) {
@@ -68,7 +65,12 @@ double relative(const Vector& a, const Vector& b, double scale) {
 /// The checks of one model, printed as they run; failures are collected for the summary.
 class ModelChecks {
  public:
-  ModelChecks(const Registry& registry, const ModelEntry& entry) : registry_(registry), entry_(entry) {}
+  ModelChecks(const Registry& registry, const ModelEntry& entry, const CheckOptions& options)
+      : registry_(registry), entry_(entry), options_(options) {
+    // When the order over the given steps misses, they may still be pre-asymptotic for this
+    // model: if the order over steps four times finer settles, that fit counts.
+    for (const long n : options_.steps) finer_steps_.push_back(4 * n);
+  }
 
   void interface(double eps);
   void convergence(const std::vector<const SchemeEntry*>& schemes, const std::vector<double>& epsilons);
@@ -79,6 +81,19 @@ class ModelChecks {
     failures_.push_back(why);
   }
   const std::vector<std::string>& failures() const { return failures_; }
+  /// The model section of the checks' configs: the user's --set model parameters and eps.
+  Json model_section(double eps) const {
+    Json m = options_.model_params;
+    m["name"] = entry_.info.name;
+    m["eps"] = eps;
+    return m;
+  }
+  std::shared_ptr<const Model> model(double eps) const {
+    Json params = model_section(eps);
+    params.erase("name");
+    return entry_.create(Params(resolve_params(entry_.info.params, params, "model")));
+  }
+
   int count() const { return count_; }
 
  private:
@@ -93,40 +108,36 @@ class ModelChecks {
            fmt::format("{}: {:.2e} exceeds {:.0e}", what, value, limit), hint);
   }
 
-  std::shared_ptr<const Model> model(double eps) const {
-    return entry_.create(Params(resolve_params(entry_.info.params, Json{{"eps", eps}}, "model")));
-  }
-  std::unique_ptr<Reformulation> reformulation(const std::string& name, std::shared_ptr<const Model> m,
-                                               const Json& params) const {
-    const ReformulationEntry& e = registry_.reformulation(name);
-    return e.create(std::move(m), Params(resolve_params(e.info.params, params, "reformulation")));
-  }
-  std::unique_ptr<Stepper> stepper(const SchemeEntry& e, double tol, int max_iter) const {
-    Json params = Json::object();
-    for (const auto& p : e.info.params) {
-      if (p.name == "tol") params["tol"] = tol;
-      if (p.name == "max_iter") params["max_iter"] = max_iter;
+  /// A run's objects through the core's assembler (as `tsi run` builds them): the scheme's tol
+  /// and max_iter where it takes them, every other default completed by the entries.
+  Assembly assembly(const SchemeEntry& scheme, const std::string& reformulation, double eps, double tol,
+                    int max_iter) const {
+    Json scheme_section = {{"name", scheme.info.name}};
+    for (const auto& p : scheme.info.params) {
+      if (p.name == "tol") scheme_section["tol"] = tol;
+      if (p.name == "max_iter") scheme_section["max_iter"] = max_iter;
     }
-    params = resolve_params(e.info.params, params, "scheme");
-    if (params.contains("quadrature_nodes") && params["quadrature_nodes"].is_null())
-      params["quadrature_nodes"] = default_quadrature_nodes(entry_);
-    return e.create(Params(params));
+    return assemble_config({{"model", model_section(eps)},
+                            {"reformulation", {{"name", reformulation}}},
+                            {"scheme", scheme_section}},
+                           registry_);
   }
-  std::unique_ptr<Reformulation> two_scale_problem(const SchemeEntry& scheme,
-                                                   std::shared_ptr<const Model> m) const {
-    return reformulation("two-scale", std::move(m),
-                         {{"n_tau", entry_.default_n_tau},
-                          {"initial_data_order", std::max(1, scheme.traits.initial_data_order)}});
-  }
+  /// What limits h for this model whatever eps: the size of J Hess H1 at u0 (a power
+  /// iteration on nonlinear_field_derivative). An explicit treatment of H1 needs h L <~ 2.
+  double field_stiffness(double eps) const;
+  /// The measured cause of a missed order, as advice (empty when nothing stands out).
+  std::string diagnose(const SchemeEntry& scheme, double eps, const Vector& x_ref) const;
   Vector reference(std::shared_ptr<const Model> m, const Vector& u0) const;
   /// The relative errors at T for the given numbers of steps.
   std::vector<double> errors(const SchemeEntry& scheme, double eps, const Vector& x_ref,
-                             const long (&steps)[4]) const;
+                             const std::vector<long>& steps, int n_tau_factor = 1) const;
   void orders(const SchemeEntry& scheme, double eps, const Vector& x_ref);
   void symmetry(const SchemeEntry& scheme, double eps);
 
   const Registry& registry_;
   const ModelEntry& entry_;
+  const CheckOptions& options_;
+  std::vector<long> finer_steps_;
   std::vector<std::string> failures_;
   int count_ = 0;
 };
@@ -160,6 +171,18 @@ void ModelChecks::interface(double eps) {
   check("d/dtau linear_flow(tau) u at 0 = J M u",
         relative(derivative, jmw, std::max(max_norm(jmw), omega * w_norm)), 1e-6,
         "the flow must be generated by apply_J(apply_M(u)): the flow, M and J disagree (a sign or a factor)");
+
+  if (mod.has_linear_remainder()) {
+    // J R must commute with J M: the two-scale multipliers -i k/eps + i omega_j assume that
+    // e^{JR t} acts on every tau mode alike.
+    Vector rl = mod.linear_flow(0.9, w), lr = w;
+    mod.remainder_flow(0.37, rl);
+    mod.remainder_flow(0.37, lr);
+    lr = mod.linear_flow(0.9, lr);
+    check("remainder_flow commutes with linear_flow", relative(rl, lr, w_norm), 1e-12,
+          "linear_remainder() gives the frequencies of J R in the model's coordinates, and J R must commute "
+          "with J M (both diagonal in the model's coordinates)");
+  }
 
   // Batched calls: one state per column, each column on its own.
   Matrix states(n, 3), dirs(n, 3);
@@ -230,100 +253,147 @@ void ModelChecks::interface(double eps) {
 }
 
 Vector ModelChecks::reference(std::shared_ptr<const Model> m, const Vector& u0) const {
-  auto filtered = reformulation("filtered", m, Json::object());
-  const SchemeEntry& rk78 = registry_.scheme("rk78", "reference.scheme");
-  auto ref = stepper(rk78, reference_tol, 200);
-  Vector y = filtered->prepare(u0);
-  integrate(*filtered, *ref, y, t_end, 1, {});
-  return filtered->read_back(y, t_end);
+  Assembly a = assembly(registry_.scheme("rk78", "reference.scheme"), "filtered", m->eps(), reference_tol, 200);
+  Vector y = a.reformulation->prepare(u0);
+  integrate(*a.reformulation, *a.stepper, y, t_end, 1, {});
+  return a.reformulation->read_back(y, t_end);
 }
 
 std::vector<double> ModelChecks::errors(const SchemeEntry& scheme, double eps, const Vector& x_ref,
-                                        const long (&steps)[4]) const {
+                                        const std::vector<long>& steps, int n_tau_factor) const {
   std::vector<double> out;
   for (const long n : steps) {
-    const auto m = model(eps);
-    auto problem = two_scale_problem(scheme, m);
-    auto s = stepper(scheme, 1e-12, 200);
+    Assembly a = assembly(scheme, "two-scale", eps, 1e-12, 200);
+    if (n_tau_factor != 1) {  // the same run on a finer tau grid (diagnose)
+      Json config = {{"model", model_section(eps)}, {"reformulation", {{"name", "two-scale"}}},
+                     {"scheme", {{"name", scheme.info.name}}}};
+      const Json resolved = resolve_selection(config, registry_);
+      config["reformulation"]["n_tau"] = n_tau_factor * resolved["reformulation"]["n_tau"].get<long>();
+      for (const auto& p : scheme.info.params)
+        if (p.name == "tol") config["scheme"]["tol"] = 1e-12;
+      a = assemble_config(config, registry_);
+    }
     const double h = t_end / static_cast<double>(n);
-    Vector y = problem->prepare(m->initial_value());
-    integrate(*problem, *s, y, h, n, {});
-    const Vector x = m->to_physical(problem->read_back(y, step_time(n, h)));
-    out.push_back(m->error_norm(x - x_ref) / m->error_norm(x_ref));
+    Vector y = a.reformulation->prepare(a.u0);
+    double error = std::numeric_limits<double>::quiet_NaN();
+    try {
+      integrate(*a.reformulation, *a.stepper, y, h, n, {});
+      const Vector x = a.model->to_physical(a.reformulation->read_back(y, step_time(n, h)));
+      error = a.model->error_norm(x - x_ref) / a.model->error_norm(x_ref);
+    } catch (const Error&) {
+      // a diverged stage or a non-finite state: a failed run, reported as not finite
+    }
+    out.push_back(error);
   }
   return out;
 }
 
 namespace {
 
-/// The observed order over the errors above the floor (at least three of them), if any.
-struct Fit {
-  bool finite = false, measurable = false;
-  double order = 0.0;
-  size_t used = 0;
-};
+std::vector<double> step_sizes(const std::vector<long>& steps) {
+  std::vector<double> h;
+  for (const long n : steps) h.push_back(t_end / static_cast<double>(n));
+  return h;
+}
 
-Fit fit_order(const long (&steps)[4], const std::vector<double>& errors) {
-  Fit f;
-  f.finite = std::all_of(errors.begin(), errors.end(), [](double e) { return std::isfinite(e); });
-  std::vector<double> hs, es;
-  for (size_t i = 0; i < errors.size(); ++i)
-    if (errors[i] >= error_floor)
-      hs.push_back(t_end / static_cast<double>(steps[i])), es.push_back(errors[i]);
-  f.used = es.size();
-  f.measurable = f.finite && es.size() >= 3;
-  if (f.measurable) f.order = least_squares_order(hs, es);
-  return f;
+std::string step_range(const std::vector<long>& steps) {
+  return fmt::format("h = 1/{} .. 1/{}", steps.front(), steps.back());
 }
 
 }  // namespace
 
+double ModelChecks::field_stiffness(double eps) const {
+  const auto m = model(eps);
+  const Vector u0 = m->initial_value();
+  Vector z = sample_state(*m, Vector::Zero(m->dim()), 0.7);
+  double rate = 0.0;
+  Matrix out(m->dim(), 1);
+  for (int k = 0; k < 30; ++k) {  // the growth of z under J Hess H1(u0): its largest eigenvalue's modulus
+    const double norm = z.norm();
+    if (!(norm > 0.0)) return 0.0;
+    z /= norm;
+    m->nonlinear_field_derivative(u0, z, out);
+    rate = out.col(0).norm();
+    z = out.col(0);
+  }
+  return rate;
+}
+
+std::string ModelChecks::diagnose(const SchemeEntry& scheme, double eps, const Vector& x_ref) const {
+  std::vector<std::string> causes;
+  const double coarsest = t_end / static_cast<double>(options_.steps.front());
+  const double stiffness = field_stiffness(eps);
+  if (coarsest * stiffness > 1.0)
+    causes.push_back(fmt::format(
+        "measured: J Hess H1 at u0 has size {:.3g}, so h = {:g} times it is {:.2g}: the nonlinear part is "
+        "stiff and limits h to about 2 / {:.3g} = {:.2g} whatever eps. If a large linear part sits in H1, "
+        "hand it over as Model::linear_remainder (docs/writing-a-model.md) so that it is integrated exactly",
+        stiffness, coarsest, coarsest * stiffness, stiffness, 2.0 / stiffness));
+  const std::vector<long> finest = {options_.steps.back()};
+  const double plain = errors(scheme, eps, x_ref, finest).front();
+  const double doubled = errors(scheme, eps, x_ref, finest, 2).front();
+  if (std::isfinite(plain) && std::isfinite(doubled) && std::abs(plain - doubled) > 0.25 * std::abs(doubled))
+    causes.push_back(fmt::format(
+        "measured: doubling n_tau moves the error at h = 1/{} from {:.2e} to {:.2e}: the tau grid does not "
+        "resolve the tau dependence; raise the model's default_n_tau (or reformulation.n_tau)",
+        finest.front(), plain, doubled));
+  std::string out;
+  for (const auto& c : causes) out += (out.empty() ? "" : "\n      ") + c;
+  return out;
+}
+
 void ModelChecks::orders(const SchemeEntry& scheme, double eps, const Vector& x_ref) {
-  const auto within = [&](const Fit& f) {
+  const auto within = [&](const OrderFit& f) {
     return f.measurable && std::abs(f.order - scheme.traits.order) <= order_margin;
   };
-  const std::vector<double> errs = errors(scheme, eps, x_ref, step_counts);
-  const Fit fit = fit_order(step_counts, errs);
+  const std::vector<long>& steps = options_.steps;
+  const std::vector<double> errs = errors(scheme, eps, x_ref, steps);
+  const OrderFit fit = fit_order(step_sizes(steps), errs, error_floor);
   std::string row;
   for (const double e : errs) row += fmt::format(" {:>9.2e}", e);
   std::string note;
-  bool ok = within(fit) || (fit.finite && !fit.measurable);
+  bool ok = within(fit) || (fit.finite && !fit.measurable && fit.used == 0);
   if (!fit.finite)
-    note = "  (not finite: blow-up)";
+    note = "  (not finite: blow-up or a failed run)";
   else if (!fit.measurable)
     note = fmt::format("  (errors below {:.0e}: no order to observe)", error_floor);
   else if (fit.used < errs.size())
     note = fmt::format("  (over the {} errors above {:.0e})", fit.used, error_floor);
-  Fit finer;
+  OrderFit finer;
   if (!ok && fit.finite) {
-    const std::vector<double> finer_errs = errors(scheme, eps, x_ref, finer_step_counts);
-    finer = fit_order(finer_step_counts, finer_errs);
+    const std::vector<double> finer_errs = errors(scheme, eps, x_ref, finer_steps_);
+    finer = fit_order(step_sizes(finer_steps_), finer_errs, error_floor);
     ok = within(finer);
-    note = finer.measurable ? fmt::format("  ({:.2f} over h = 1/16 .. 1/128)", finer.order) : "";
+    note = finer.measurable ? fmt::format("  ({:.2f} over {})", finer.order, step_range(finer_steps_)) : "";
   }
   const std::string observed = fit.measurable ? fmt::format("{:.2f}", fit.order) : "-";
+  std::string hint;
+  if (!ok) {
+    hint = diagnose(scheme, eps, x_ref);
+    if (hint.empty())
+      hint = fit.finite ? "nothing measured stands out (the field is not stiff at u0 and n_tau resolves tau): the "
+                          "two-scale schemes reach their order only on a model of the problem class; see the "
+                          "interface lines above"
+                        : "the run blew up or its implicit stages diverged, and the field is not stiff at u0: if "
+                          "the model is strongly nonlinear at this eps, the steps do not resolve it; try --steps "
+                          "with more steps, or the eps of its regime with --eps";
+  }
   report(ok,
          fmt::format("{:<12} {:<8g}{} {:>6}  {} +- {:g}{}", scheme.info.name, eps, row, observed,
                      scheme.traits.order, order_margin, note),
          fmt::format("{} at eps = {:g}: observed order {}{}, expected {} +- {:g}", scheme.info.name, eps,
-                     observed,
-                     finer.measurable ? fmt::format(" ({:.2f} over h = 1/16 .. 1/128)", finer.order) : "",
+                     fit.finite ? observed : "- (not finite)",
+                     finer.measurable ? fmt::format(" ({:.2f} over {})", finer.order, step_range(finer_steps_)) : "",
                      scheme.traits.order, order_margin),
-         fit.finite
-             ? "the two-scale schemes reach their order only on a model of the problem class: see the "
-               "interface lines above; n_tau (default_n_tau) must resolve the tau dependence"
-             : "the run blew up or its implicit stages diverged: if the model is strongly nonlinear at this "
-               "eps, h = 1/4 .. 1/32 does not resolve it; check the eps of its regime with --eps");
+         hint);
 }
 
 void ModelChecks::symmetry(const SchemeEntry& scheme, double eps) {
-  const auto m = model(eps);
-  auto problem = two_scale_problem(scheme, m);
-  auto s = stepper(scheme, 1e-14, 1000);
-  const Vector start = problem->prepare(m->initial_value());
+  Assembly a = assembly(scheme, "two-scale", eps, 1e-14, 1000);
+  const Vector start = a.reformulation->prepare(a.u0);
   Vector y = start;
-  s->step(*problem, 0.0, symmetry_step, y);
-  s->step(*problem, symmetry_step, -symmetry_step, y);
+  a.stepper->step(*a.reformulation, 0.0, symmetry_step, y);
+  a.stepper->step(*a.reformulation, symmetry_step, -symmetry_step, y);
   const double back = max_norm(y - start) / max_norm(start);
   check(fmt::format("{:<8} eps = {:g}: returns to", scheme.info.name, eps), back, symmetry_limit,
         "a symmetric scheme's step h then -h returns the state; if the model is smooth this points at "
@@ -346,7 +416,7 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
           "model's H1, with the M and J of linear_flow");
   }
   for (const double eps : epsilons) {
-    const std::string resonant = resonant_steps(eps);
+    const std::string resonant = resonant_steps(options_.steps, eps);
     if (!resonant.empty())
       fmt::print(
           "    note: at eps = {:g}, {} close to a whole number of half fast periods (pi eps):\n"
@@ -357,10 +427,10 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
     fmt::print("\n  no scheme integrates the two-scale problem: no orders to check\n");
     return;
   }
-  fmt::print("\n  order at T = {:g}, h = 1/4 .. 1/32, relative error against the reference\n", t_end);
+  fmt::print("\n  order at T = {:g}, {}, relative error against the reference\n", t_end, step_range(options_.steps));
   fmt::print("    {:<5} {:<12} {:<8}", "", "scheme", "eps");
-  for (const long steps : step_counts)
-    fmt::print(" {:>9}", fmt::format("{}1/{}", steps == step_counts[0] ? "h = " : "", steps));
+  for (const long steps : options_.steps)
+    fmt::print(" {:>9}", fmt::format("{}1/{}", steps == options_.steps.front() ? "h = " : "", steps));
   fmt::print(" {:>6}  {}\n", "order", "expected");
   for (const auto* scheme : schemes) {
     for (size_t k = 0; k < epsilons.size(); ++k) {
@@ -408,6 +478,19 @@ int check_command(PluginLoader& loader, const Registry& registry, CheckOptions o
   }
   for (const auto& file : runner_plugins) providers.insert(canonical(file));
   if (options.epsilons.empty()) options.epsilons = {1.0, 1e-3};
+  if (options.steps.empty()) options.steps = {4, 8, 16, 32};
+  if (options.steps.size() < 3)
+    throw ConfigError("check --steps", fmt::format("got {} step counts, expected at least 3 to observe an order",
+                                                   options.steps.size()));
+  for (size_t i = 0; i < options.steps.size(); ++i)
+    if (options.steps[i] < 1 || options.steps[i] > 1000000 || (i > 0 && options.steps[i] <= options.steps[i - 1]))
+      throw ConfigError("check --steps", fmt::format("got {}, expected increasing step counts from 1 to 1000000",
+                                                     options.steps[i]));
+  if (!options.model_params.is_object()) options.model_params = Json::object();
+  for (const char* key : {"name", "eps", "u0"})
+    if (options.model_params.contains(key))
+      throw ConfigError(std::string("check --set model.") + key,
+                        "is chosen by the check itself (the model is the one checked, eps by --eps)");
   for (const double eps : options.epsilons)
     if (!(eps > 0.0 && eps <= 1.0))
       throw ConfigError("check --eps", fmt::format("got {:g}, expected a number in (0, 1]", eps));
@@ -440,14 +523,21 @@ int check_command(PluginLoader& loader, const Registry& registry, CheckOptions o
     for (const auto* e : registry.schemes())
       if (two_scale(*e)) schemes.push_back(e);
 
+  if (!options.model_params.empty() && models.size() > 1)
+    throw ConfigError("check --set", "model parameters need one model to check: name it (tsi check MODEL --set ...)");
+  if (!options.model_params.empty()) {  // bad parameters are bad input, refused before any check runs
+    Json params = options.model_params;
+    params["eps"] = options.epsilons.front();
+    resolve_params(models.front()->info.params, params, "model");
+  }
+
   int failed_models = 0;
   for (const auto* entry : models) {
     const auto start = std::chrono::steady_clock::now();
     fmt::print("{} (provided by {})\n", entry->info.name, entry->info.provider);
-    ModelChecks checks(registry, *entry);
+    ModelChecks checks(registry, *entry, options);
     try {
-      const auto m = entry->create(
-          Params(resolve_params(entry->info.params, Json{{"eps", options.epsilons.front()}}, "model")));
+      const auto m = checks.model(options.epsilons.front());
       fmt::print("  dim {}, {}, default n_tau {}, nonlinearity degree {}\n\n", m->dim(),
                  m->is_complex() ? "complex" : "real", entry->default_n_tau, entry->nonlinearity_degree);
       checks.interface(options.epsilons.front());

@@ -2,6 +2,7 @@
 #include <string>
 #include <vector>
 
+#include "tsi/params.hpp"
 #include "tsi/plugin_loader.hpp"
 #include "tsi/registry.hpp"
 
@@ -13,6 +14,8 @@ struct CheckOptions {
   std::vector<std::string> plugins;  ///< plugin files (loaded if needed) whose entries are checked
   std::vector<std::string> schemes;  ///< restrict to these two-scale schemes (empty: see check_command)
   std::vector<double> epsilons;      ///< the eps values of the order checks (empty: 1 and 1e-3)
+  std::vector<long> steps;           ///< numbers of steps over T = 1 of the order fits (empty: 4, 8, 16, 32)
+  Json model_params = Json::object();  ///< model parameters besides eps (--set model.KEY=VALUE)
 };
 
 /// `tsi check [MODEL] [--plugin FILE] [--scheme NAME] [--eps EPS]`: the conformance checks of

@@ -100,6 +100,10 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   check->add_option("--scheme", check_options.schemes, "check with this two-scale scheme only (repeatable)");
   check->add_option("--eps", check_options.epsilons, "eps of the order checks (repeatable; default 1 and 1e-3)");
+  check->add_option("--steps", check_options.steps,
+                    "numbers of steps over T = 1 of the order fits (repeatable, increasing; default 4 8 16 32)");
+  std::vector<std::string> check_overrides;
+  check->add_option("--set", check_overrides, "a model parameter: model.KEY=VALUE (repeatable), e.g. model.n_x=64");
   // The runner's own options (--plugin) may also follow a subcommand: tsi run CONFIG --plugin FILE.
   for (auto* sub : app.get_subcommands([](CLI::App*) { return true; })) sub->fallthrough();
   // end tsi check
@@ -121,7 +125,16 @@ int main(int argc, char** argv) {
                                : tsi::app::list_text(registry, what));
       return 0;
     }
-    if (check->parsed()) return tsi::app::check_command(loader, registry, check_options, plugin_files);
+    if (check->parsed()) {
+      tsi::Json model_overrides = {{"model", tsi::Json::object()}};
+      for (const auto& assignment : check_overrides) {
+        if (assignment.rfind("model.", 0) != 0)
+          throw tsi::ConfigError("check --set", "got \"" + assignment + "\", expected model.KEY=VALUE (model parameters only)");
+        tsi::app::apply_override(model_overrides, assignment);
+      }
+      check_options.model_params = model_overrides["model"];
+      return tsi::app::check_command(loader, registry, check_options, plugin_files);
+    }
     if (study->parsed())
       return tsi::app::study_command(loader, registry, study_path, study_out, jobs, study_overrides, !no_plots);
     return run_command(loader, registry, config_path, out_dir, overrides);

@@ -93,15 +93,14 @@ double drift_slope(const std::string& csv, const std::string& column, double t_f
   const auto it = std::find(header.begin(), header.end(), column);
   if (it == header.end()) return std::nan("");
   const size_t col = static_cast<size_t>(it - header.begin());
-  double n = 0, st = 0, sy = 0, stt = 0, sty = 0;
+  std::vector<double> t, y;
   while (std::getline(in, line)) {
     std::vector<double> v;
     for (std::istringstream fields(line); std::getline(fields, line, ',');) v.push_back(std::stod(line));
-    if (v.size() <= col || v[0] < t_from) continue;
-    n += 1, st += v[0], sy += v[col], stt += v[0] * v[0], sty += v[0] * v[col];
+    if (v.size() <= col) continue;
+    t.push_back(v[0]), y.push_back(v[col]);
   }
-  const double denominator = n * stt - st * st;
-  return n >= 2 && denominator > 0 ? (n * sty - st * sy) / denominator : std::nan("");
+  return drift_fit(t, y, t_from).slope;
 }
 
 Json study_rows(const Study& study, const std::vector<RunOutcome>& outcomes) {

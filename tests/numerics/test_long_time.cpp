@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "harness.hpp"
+#include "tsi/convergence.hpp"
 
 namespace {
 
@@ -42,16 +43,8 @@ struct Drift {
 };
 
 Drift drift(const EnergyRecord& r, double from) {
-  double n = 0, st = 0, se = 0, stt = 0, ste = 0;
-  for (size_t i = 0; i < r.t.size(); ++i) {
-    if (r.t[i] < from) continue;
-    n += 1, st += r.t[i], se += r.err_H[i], stt += r.t[i] * r.t[i], ste += r.t[i] * r.err_H[i];
-  }
-  const double slope = (n * ste - st * se) / (n * stt - st * st), intercept = (se - slope * st) / n;
-  double ss = 0;
-  for (size_t i = 0; i < r.t.size(); ++i)
-    if (r.t[i] >= from) ss += std::pow(r.err_H[i] - intercept - slope * r.t[i], 2);
-  return {slope * (r.t.back() - from), std::sqrt(ss / n)};
+  const tsi::DriftFit fit = tsi::drift_fit(r.t, r.err_H, from);
+  return {fit.slope * (r.t.back() - from), fit.residual_rms};
 }
 
 }  // namespace

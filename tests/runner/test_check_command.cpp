@@ -82,3 +82,36 @@ TEST_CASE("check: bad input is exit code 2 with a message") {
 }
 
 }  // TEST_SUITE
+
+TEST_CASE("check: a stiff linear part folded into H1 fails with the measured cause; handed over, it passes") {
+  const std::string plugin = t::fixture_plugin("stiff");
+  const t::CommandResult folded = t::run_tsi({"check", "fixture-stiff", "--plugin", plugin, "--set",
+                                              "model.remainder=in-h1", "--scheme", "se2", "--eps", "1"});
+  INFO(folded.describe());
+  CHECK(folded.exit_code == 1);
+  CHECK(t::contains(folded.out, "J Hess H1 at u0 has size 392"));  // 8 * 7^2, measured by power iteration
+  CHECK(t::contains(folded.out, "Model::linear_remainder"));
+  const t::CommandResult exact =
+      t::run_tsi({"check", "fixture-stiff", "--plugin", plugin, "--set", "model.remainder=exact", "--scheme", "se2",
+                  "--eps", "1", "--steps", "4", "--steps", "8", "--steps", "16", "--steps", "32"});
+  INFO(exact.describe());
+  CHECK(exact.exit_code == 0);
+  CHECK(t::contains(exact.out, "ok    remainder_flow commutes with linear_flow"));
+  CHECK(t::contains(exact.out, "h = 1/4 .. 1/32"));
+}
+
+TEST_CASE("check: --set and --steps are checked before anything runs") {
+  const std::string plugin = t::fixture_plugin("stiff");
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--set", "model.nosuch=3"}, {"--set", "remainder=exact"},
+        {"--set", "model.remainder=sideways"}, {"--steps", "4", "--steps", "2", "--steps", "8"},
+        {"--steps", "4", "--steps", "8"}}) {
+    std::vector<std::string> command = {"check", "fixture-stiff", "--plugin", plugin};
+    command.insert(command.end(), args.begin(), args.end());
+    const t::CommandResult r = t::run_tsi(command);
+    INFO(r.describe());
+    CHECK(r.exit_code == 2);
+    CHECK((t::contains(r.err, "--set") || t::contains(r.err, "--steps") || t::contains(r.err, "model.")));
+    CHECK(r.out.find("checks passed") == std::string::npos);
+  }
+}
