@@ -137,7 +137,7 @@ TEST_CASE("loader: a directory scan collects failures without throwing") {
   // shipped_duplicate's "henon-heiles" is free here (no shipped plugins in this registry).
   const std::vector<std::pair<const char*, bool>> expected = {
       {"broken_flow", true}, {"broken_fused", true},      {"duplicate", true},        {"good", false},
-      {"no_entry", false},   {"shipped_duplicate", true}, {"throws", false},
+      {"no_entry", false},   {"shipped_duplicate", true}, {"stiff", true},           {"throws", false},
       {"wrong_abi", false},  {"wrong_layout", false},     {"wrong_major", false}};
   REQUIRE(reports.size() == expected.size());
   for (std::size_t i = 0; i < reports.size(); ++i) {
@@ -147,7 +147,7 @@ TEST_CASE("loader: a directory scan collects failures without throwing") {
     CHECK(reports[i].error.empty() == expected[i].second);
   }
   CHECK(reports[3].error.find("already registered") != std::string::npos);
-  CHECK(reports[8].error.find("tsi::ModelEntry") != std::string::npos);
+  CHECK(reports[9].error.find("tsi::ModelEntry") != std::string::npos);
   CHECK(r.scheme("fixture-duplicate-scheme").info.provider == fixture("duplicate"));
   CHECK(loader.reports().size() == reports.size());
 }
