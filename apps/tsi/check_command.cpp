@@ -18,6 +18,21 @@ namespace tsi::app {
 namespace {
 
 constexpr double t_end = 1.0;
+
+/// The eps and steps of a check (given, or the model's declared regime), refused when bad.
+void check_regime(const std::vector<double>& epsilons, const std::vector<long>& steps) {
+  for (const double eps : epsilons)
+    if (!(eps > 0.0 && eps <= 1.0))
+      throw ConfigError("check --eps", fmt::format("got {:g}, expected a number in (0, 1]", eps));
+  if (epsilons.empty()) throw ConfigError("check --eps", "no eps to check");
+  if (steps.size() < 3)
+    throw ConfigError("check --steps", fmt::format("got {} step counts, expected at least 3 to observe an order",
+                                                   steps.size()));
+  for (size_t i = 0; i < steps.size(); ++i)
+    if (steps[i] < 1 || steps[i] > 1000000 || (i > 0 && steps[i] <= steps[i - 1]))
+      throw ConfigError("check --steps",
+                        fmt::format("got {}, expected increasing step counts from 1 to 1000000", steps[i]));
+}
 constexpr double reference_tol = 1e-12;
 constexpr double order_margin = 0.2;
 constexpr double symmetry_step = 0.25, symmetry_limit = 1e-10;
@@ -379,7 +394,7 @@ void ModelChecks::orders(const SchemeEntry& scheme, double eps, const Vector& x_
                           "with more steps, or the eps of its regime with --eps";
   }
   report(ok,
-         fmt::format("{:<12} {:<8g}{} {:>6}  {} +- {:g}{}", scheme.info.name, eps, row, observed,
+         fmt::format("{:<12} {:<10.4g}{} {:>6}  {} +- {:g}{}", scheme.info.name, eps, row, observed,
                      scheme.traits.order, order_margin, note),
          fmt::format("{} at eps = {:g}: observed order {}{}, expected {} +- {:g}", scheme.info.name, eps,
                      fit.finite ? observed : "- (not finite)",
@@ -428,7 +443,7 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
     return;
   }
   fmt::print("\n  order at T = {:g}, {}, relative error against the reference\n", t_end, step_range(options_.steps));
-  fmt::print("    {:<5} {:<12} {:<8}", "", "scheme", "eps");
+  fmt::print("    {:<5} {:<12} {:<10}", "", "scheme", "eps");
   for (const long steps : options_.steps)
     fmt::print(" {:>9}", fmt::format("{}1/{}", steps == options_.steps.front() ? "h = " : "", steps));
   fmt::print(" {:>6}  {}\n", "order", "expected");
@@ -477,24 +492,6 @@ int check_command(PluginLoader& loader, const Registry& registry, CheckOptions o
     providers.insert(canonical(file));
   }
   for (const auto& file : runner_plugins) providers.insert(canonical(file));
-  if (options.epsilons.empty()) options.epsilons = {1.0, 1e-3};
-  if (options.steps.empty()) options.steps = {4, 8, 16, 32};
-  if (options.steps.size() < 3)
-    throw ConfigError("check --steps", fmt::format("got {} step counts, expected at least 3 to observe an order",
-                                                   options.steps.size()));
-  for (size_t i = 0; i < options.steps.size(); ++i)
-    if (options.steps[i] < 1 || options.steps[i] > 1000000 || (i > 0 && options.steps[i] <= options.steps[i - 1]))
-      throw ConfigError("check --steps", fmt::format("got {}, expected increasing step counts from 1 to 1000000",
-                                                     options.steps[i]));
-  if (!options.model_params.is_object()) options.model_params = Json::object();
-  for (const char* key : {"name", "eps", "u0"})
-    if (options.model_params.contains(key))
-      throw ConfigError(std::string("check --set model.") + key,
-                        "is chosen by the check itself (the model is the one checked, eps by --eps)");
-  for (const double eps : options.epsilons)
-    if (!(eps > 0.0 && eps <= 1.0))
-      throw ConfigError("check --eps", fmt::format("got {:g}, expected a number in (0, 1]", eps));
-
   std::vector<const ModelEntry*> models;
   std::vector<const SchemeEntry*> schemes;
   if (!options.model.empty()) {
@@ -523,11 +520,19 @@ int check_command(PluginLoader& loader, const Registry& registry, CheckOptions o
     for (const auto* e : registry.schemes())
       if (two_scale(*e)) schemes.push_back(e);
 
+  if (!options.epsilons.empty() || !options.steps.empty())
+    check_regime(options.epsilons.empty() ? std::vector<double>{1.0} : options.epsilons,
+                 options.steps.empty() ? std::vector<long>{4, 8, 16} : options.steps);
+  if (!options.model_params.is_object()) options.model_params = Json::object();
+  for (const char* key : {"name", "eps", "u0"})
+    if (options.model_params.contains(key))
+      throw ConfigError(std::string("check --set model.") + key,
+                        "is chosen by the check itself (the model is the one checked, eps by --eps)");
   if (!options.model_params.empty() && models.size() > 1)
     throw ConfigError("check --set", "model parameters need one model to check: name it (tsi check MODEL --set ...)");
   if (!options.model_params.empty()) {  // bad parameters are bad input, refused before any check runs
     Json params = options.model_params;
-    params["eps"] = options.epsilons.front();
+    params["eps"] = 1.0;
     resolve_params(models.front()->info.params, params, "model");
   }
 
@@ -535,13 +540,18 @@ int check_command(PluginLoader& loader, const Registry& registry, CheckOptions o
   for (const auto* entry : models) {
     const auto start = std::chrono::steady_clock::now();
     fmt::print("{} (provided by {})\n", entry->info.name, entry->info.provider);
-    ModelChecks checks(registry, *entry, options);
+    // The model's declared regime where the command line gives none.
+    CheckOptions model_options = options;
+    if (model_options.epsilons.empty()) model_options.epsilons = entry->verification.epsilons;
+    if (model_options.steps.empty()) model_options.steps = entry->verification.steps;
+    ModelChecks checks(registry, *entry, model_options);
     try {
-      const auto m = checks.model(options.epsilons.front());
+      check_regime(model_options.epsilons, model_options.steps);
+      const auto m = checks.model(model_options.epsilons.front());
       fmt::print("  dim {}, {}, default n_tau {}, nonlinearity degree {}\n\n", m->dim(),
                  m->is_complex() ? "complex" : "real", entry->default_n_tau, entry->nonlinearity_degree);
-      checks.interface(options.epsilons.front());
-      checks.convergence(schemes, options.epsilons);
+      checks.interface(model_options.epsilons.front());
+      checks.convergence(schemes, model_options.epsilons);
     } catch (const std::exception& e) {
       checks.fail(e.what());
     }

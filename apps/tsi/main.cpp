@@ -99,9 +99,9 @@ int main(int argc, char** argv) {
   check->add_option("--plugin", check_options.plugins, "load this plugin and check what it provides")
       ->check(CLI::ExistingFile);
   check->add_option("--scheme", check_options.schemes, "check with this two-scale scheme only (repeatable)");
-  check->add_option("--eps", check_options.epsilons, "eps of the order checks (repeatable; default 1 and 1e-3)");
+  check->add_option("--eps", check_options.epsilons, "eps of the order checks (repeatable; default: the model's declared regime)");
   check->add_option("--steps", check_options.steps,
-                    "numbers of steps over T = 1 of the order fits (repeatable, increasing; default 4 8 16 32)");
+                    "numbers of steps over T = 1 of the order fits (repeatable, increasing; default: the model's regime)");
   std::vector<std::string> check_overrides;
   check->add_option("--set", check_overrides, "a model parameter: model.KEY=VALUE (repeatable), e.g. model.n_x=64");
   // The runner's own options (--plugin) may also follow a subcommand: tsi run CONFIG --plugin FILE.

@@ -7,7 +7,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "harness.hpp"
+#include "runner/run_command.hpp"
 #include "tsi/convergence.hpp"
 
 namespace {
@@ -106,5 +109,25 @@ TEST_CASE("conformance: a step h then -h returns the state exactly when the sche
           CHECK(back > 1e-8);  // would fail if the scheme became symmetric
       }
     }
+  }
+}
+
+TEST_CASE("conformance: every model with every two-scale scheme, in the model's declared regime") {
+  // One `tsi check` over all shipped models: the order of every scheme at every eps the model
+  // declares, fitted by the shared tsi::fit_order, plus the interface and symmetry checks. A
+  // new model or scheme plugin joins by registering.
+  const auto r = tsi::test::run_tsi({"check"});
+  INFO(r.describe());
+  CHECK(r.exit_code == 0);
+  CHECK_FALSE(tsi::test::contains(r.out, "FAIL"));
+  for (const auto* model : Harness::instance().registry().models()) {
+    CAPTURE(model->info.name);
+    CHECK(tsi::test::contains(r.out, model->info.name + ": all "));
+    for (const auto* scheme : two_scale_schemes())
+      for (const double eps : model->verification.epsilons) {
+        const std::string row = fmt::format("ok    {:<12} {:<10.4g}", scheme->info.name, eps);
+        CAPTURE(row);
+        CHECK(tsi::test::contains(r.out, row));
+      }
   }
 }

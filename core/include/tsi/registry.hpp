@@ -43,8 +43,16 @@ struct TSI_API Selection {
 /// schema check, before anything is built.
 using CompleteFn = std::function<void(Json& params, const Selection& selection)>;
 
+/// Where a model's order is observable at T = 1 from its default u0: `tsi check`'s defaults
+/// and the regime of the conformance suite, which runs every scheme there.
+struct TSI_API VerificationRegime {
+  std::vector<double> epsilons = {1.0, 1e-3};  ///< in (0, 1]
+  std::vector<long> steps = {4, 8, 16, 32};    ///< numbers of steps over T = 1, increasing
+};
+
 struct TSI_API ModelEntry {
   EntryInfo info;
+  VerificationRegime verification;
   int default_n_tau = 64;  ///< tau resolution for the two-scale reformulation (SPEC.md sec. 4)
   /// Degree of J grad H1 as a polynomial in u (Henon-Heiles 2, NLS 3), 0 if not polynomial:
   /// sets the Gauss-Legendre nodes of average-vector-field schemes (quadrature_nodes).

@@ -114,6 +114,7 @@ void register_henon_heiles(tsi::Registry& registry) {
   entry.info.summary = "Henon-Heiles with a fast (q1, p1) oscillator (eq. HH model), dim 4";
   entry.default_n_tau = 64;
   entry.nonlinearity_degree = 2;
+  entry.verification = {{1.0, 1.0 / 16, 1.0 / 256, 1.0 / 4096, 1e-6}, {4, 8, 16, 32, 64}};
   entry.create = [](const tsi::Params& p) { return std::make_unique<HenonHeiles>(p.number("eps")); };
   registry.add_model(std::move(entry));
 }

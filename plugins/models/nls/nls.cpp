@@ -295,6 +295,7 @@ void register_nls(tsi::Registry& registry) {
               "an even integer in [2, 1048576]")};
   entry.default_n_tau = 256;
   entry.nonlinearity_degree = 3;
+  entry.verification = {{1.0, 1.0 / 16, 1.0 / 256}, {4, 8, 16, 32}};
   entry.create = [](const tsi::Params& p) {
     return std::make_unique<Nls>(p.number("eps"), static_cast<int>(p.integer("n_x")));
   };
