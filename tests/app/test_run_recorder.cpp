@@ -43,7 +43,8 @@ Json config(double h, double t_end) {
 struct Setup {
   std::shared_ptr<const tsi::Model> model;
   std::unique_ptr<tsi::Reformulation> direct;
-  explicit Setup(std::vector<ModelInvariant> invariants) : model(std::make_shared<DeclaringModel>(1.0, std::move(invariants))) {
+  explicit Setup(std::vector<ModelInvariant> invariants)
+      : model(std::make_shared<DeclaringModel>(1.0, std::move(invariants))) {
     tsi::Registry registry;
     tsi::register_core(registry);
     const auto& entry = registry.reformulation("direct");
@@ -62,7 +63,10 @@ Vector exact(double t) {
 TEST_CASE("recorder: a declared invariant gets a value and a change column, relative or absolute") {
   Setup s(sample_invariants());
   tsi::app::RunRecorder recorder(*s.model, *s.direct, exact(0.0), config(0.5, 1.0));
-  for (long n = 0; n <= 2; ++n) REQUIRE(recorder.observe(n, 0.5 * static_cast<double>(n), exact(0.5 * static_cast<double>(n))));
+  for (long n = 0; n <= 2; ++n) {
+    const double t = 0.5 * static_cast<double>(n);
+    REQUIRE(recorder.observe(n, t, exact(t)));
+  }
   const std::string csv = recorder.csv();
   CHECK(csv.substr(0, csv.find('\n')) == "t,H,I,m,err_H,err_I,err_m,tau_roughness,Q,err_Q,z,abs_err_z");
 
