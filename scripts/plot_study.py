@@ -5,7 +5,9 @@ the figures can be restyled without rerunning anything:
     python3 scripts/plot_study.py OUT_DIR
 
 convergence:    convergence.png     error against h, one panel per scheme, one curve per eps
-conservation:   conservation.png    err_H, err_I, err_m against t, one row per scheme
+conservation:   conservation.png    err_H, err_I, err_m against t, one row per scheme, and a
+                                    panel more per invariant the models declare (err_P,
+                                    abs_err_P, err_mu: the change columns of invariants.csv)
 work-precision: work_precision.png  error against wall time and against evaluations
 """
 import csv
@@ -65,29 +67,47 @@ def plot_convergence(rows, title, out):
     fig.savefig(os.path.join(out, "convergence.png"), dpi=110)
 
 
+CHANGES = ("err_H", "err_I", "err_m")
+
+
 def read_invariants(path):
+    """Every column of a run's invariants.csv, by name."""
     with open(path) as f:
         data = list(csv.DictReader(f))
-    return {k: [number(d[k]) for d in data] for k in ("t", "err_H", "err_I", "err_m")}
+    keys = data[0].keys() if data else ()
+    return {k: [number(d[k]) for d in data] for k in keys}
+
+
+def declared_changes(inv):
+    """The change columns of the invariants a model declares: err_<name> or abs_err_<name>."""
+    return [k for k in inv if k.startswith(("err_", "abs_err_")) and k not in CHANGES]
 
 
 def plot_conservation(rows, title, out):
     names = list(dict.fromkeys(series_name(r) for r in rows))
-    fig, axes = plt.subplots(len(names), 3, figsize=(15, 3.2 * len(names)), squeeze=False)
+    runs = {}
+    for r in rows:
+        path = os.path.join(out, "runs", r["id"], "invariants.csv")
+        if os.path.exists(path):
+            runs[r["id"]] = read_invariants(path)
+    keys = list(CHANGES)
+    for inv in runs.values():
+        keys += [k for k in declared_changes(inv) if k not in keys]
+    fig, axes = plt.subplots(len(names), len(keys), figsize=(5 * len(keys), 3.2 * len(names)), squeeze=False)
+    several_models = len({r["model"] for r in rows}) > 1
     for i, name in enumerate(names):
-        for r in (r for r in rows if series_name(r) == name):
-            path = os.path.join(out, "runs", r["id"], "invariants.csv")
-            if not os.path.exists(path):
-                continue
-            inv = read_invariants(path)
+        for k, r in enumerate(r for r in rows if series_name(r) == name and r["id"] in runs):
+            inv = runs[r["id"]]
             label = f"eps = {fraction(number(r['eps']))}, h = {fraction(number(r['h']))}"
+            if several_models:
+                label = f"{r['model']}, {label}"
             if r["status"] != "completed":
                 label += f" ({r['status']} at t = {number(r['t_reached']) or 0:g})"
-            for j, key in enumerate(("err_H", "err_I", "err_m")):
-                pts = [(t, e) for t, e in zip(inv["t"], inv[key]) if t > 0 and e and e > 0]
-                if pts:
-                    axes[i][j].semilogy(*zip(*pts), lw=0.8, label=label)
-        for j, key in enumerate(("err_H", "err_I", "err_m")):
+            for j, key in enumerate(keys):
+                pts = [(t, e) for t, e in zip(inv["t"], inv.get(key, ())) if t > 0 and e and e > 0]
+                if pts:  # a run keeps its colour in every panel, also where other runs have no curve
+                    axes[i][j].semilogy(*zip(*pts), lw=0.8, color=f"C{k % 10}", label=label)
+        for j, key in enumerate(keys):
             ax = axes[i][j]
             ax.set(xlabel="t", ylabel=key, title=f"{name}: {key}")
             ax.grid(True, which="both", alpha=0.3)

@@ -2,15 +2,33 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <set>
 
 #include "config.hpp"
+#include "tsi/error.hpp"
 
 namespace tsi::app {
 namespace {
 // |X - X0| / |X0| (absolute when X0 = 0).
 double relative_change(double value, double initial) {
   return std::abs(value - initial) / (initial != 0.0 ? std::abs(initial) : 1.0);
+}
+
+// A declared invariant's name and change column become columns of invariants.csv and its name a
+// key of result.json: letters, digits and '_', and no column another quantity has.
+void check_invariant_name(const std::string& name, const std::string& column, const std::set<std::string>& taken) {
+  const bool valid = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  });
+  if (!valid)
+    throw Error(fmt::format("the model declares an invariant named \"{}\": expected letters, digits and '_'", name));
+  if (taken.count(name) || taken.count(column))
+    throw Error(fmt::format("the model declares an invariant named \"{}\": its columns {} and {} must not be "
+                            "taken already (t, H, I, m, err_H, err_I, err_m, tau_roughness, or another invariant's)",
+                            name, name, column));
 }
 }  // namespace
 
@@ -27,6 +45,22 @@ RunRecorder::RunRecorder(const Model& model, Reformulation& reformulation, const
       csv_("t,H,I,m,err_H,err_I,err_m,tau_roughness\n") {
   const double initial[3] = {model.energy(u0), model.oscillatory_energy(u0), model.mass(u0)};
   for (int k = 0; k < 3; ++k) tracks_[k].initial = tracks_[k].final = initial[k];
+  std::set<std::string> taken = {"t", "H", "I", "m", "err_H", "err_I", "err_m", "tau_roughness"};
+  for (auto& invariant : model.invariants()) {
+    if (!invariant.value)
+      throw Error(fmt::format("the model declares an invariant \"{}\" without a value function", invariant.name));
+    Declared d;
+    d.initial = d.final = invariant.value(u0);
+    d.relative = std::abs(d.initial) > relative_change_threshold;
+    d.column = (d.relative ? "err_" : "abs_err_") + invariant.name;
+    check_invariant_name(invariant.name, d.column, taken);
+    taken.insert({invariant.name, d.column});
+    d.invariant = std::move(invariant);
+    declared_.push_back(std::move(d));
+  }
+  csv_.pop_back();  // the header's newline
+  for (const auto& d : declared_) csv_ += "," + d.invariant.name + "," + d.column;
+  csv_ += "\n";
 }
 
 bool RunRecorder::observe(long n, double t, const Vector& y) {
@@ -74,10 +108,18 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
   u_ = u;
   steps_ = n;
   t_ = t;
+  for (auto& d : declared_) {
+    d.final = d.invariant.value(u);
+    d.change = std::abs(d.final - d.initial) / (d.relative ? std::abs(d.initial) : 1.0);
+    d.max_change = std::max(d.max_change, d.change);
+  }
   const bool blow_up = errors[0] > max_err_H_;
-  if (n % every_ == 0 || n == n_steps_ || blow_up)
-    csv_ += fmt::format("{:.17g},{:.17g},{:.17g},{:.17g},{:.6e},{:.6e},{:.6e},{:.6e}\n", t, values[0],
-                        values[1], values[2], errors[0], errors[1], errors[2], roughness);
+  if (n % every_ == 0 || n == n_steps_ || blow_up) {
+    csv_ += fmt::format("{:.17g},{:.17g},{:.17g},{:.17g},{:.6e},{:.6e},{:.6e},{:.6e}", t, values[0], values[1],
+                        values[2], errors[0], errors[1], errors[2], roughness);
+    for (const auto& d : declared_) csv_ += fmt::format(",{:.17g},{:.6e}", d.final, d.change);
+    csv_ += "\n";
+  }
   if (blow_up) {
     status_ = "blow-up";
     message_ = fmt::format("err_H = {:.3e} exceeded monitor.max_err_H = {:g} at t = {:.6g} (step {})",
@@ -94,6 +136,13 @@ Json RunRecorder::invariants_json() const {
     out[names[k]] = {{"initial", tracks_[k].initial},
                      {"final", tracks_[k].final},
                      {"max_rel_error", tracks_[k].max_rel_error}};
+  for (const auto& d : declared_)
+    out[d.invariant.name] = {{"initial", d.initial},
+                             {"final", d.final},
+                             {"max_change", d.max_change},
+                             {"change", d.relative ? "relative" : "absolute"},
+                             {"column", d.column},
+                             {"description", d.invariant.description}};
   return out;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 #include <string>
+#include <vector>
 
 #include "tsi/params.hpp"
 #include "tsi/reformulation.hpp"
@@ -7,12 +8,18 @@
 namespace tsi::app {
 
 /// What a run records at every step: the invariants H, I, m and their largest relative
-/// changes, the tau roughness, and the rows of invariants.csv. It also watches the run:
+/// changes, the invariants the model declares (Model::invariants) and their largest changes,
+/// the tau roughness, and the rows of invariants.csv. It also watches the run:
 /// a non-finite solution or err_H above monitor.max_err_H stops it (blow-up), and a tau
 /// profile rougher than monitor.tau_roughness_warn, or one whose spread away from its tau
 /// mean grew by monitor.tau_spread_growth_warn, is reported once.
 class RunRecorder {
  public:
+  /// A declared invariant's change is relative, |X - X0| / |X0|, when |X0| exceeds this, and
+  /// absolute, |X - X0|, otherwise (a quantity that starts at 0, as the NLS momentum of real
+  /// data: its rounding would make a relative change meaningless).
+  static constexpr double relative_change_threshold = 1e-12;
+
   RunRecorder(const Model& model, Reformulation& reformulation, const Vector& u0, const Json& config);
 
   /// The step observer: false stops the integration.
@@ -36,11 +43,20 @@ class RunRecorder {
   struct Track {
     double initial = 0.0, final = 0.0, max_rel_error = 0.0;
   };
+  /// A model's invariant: its column in invariants.csv is err_<name> (relative change) or
+  /// abs_err_<name> (absolute change), after the value column <name>.
+  struct Declared {
+    ModelInvariant invariant;
+    bool relative = true;
+    std::string column;
+    double initial = 0.0, final = 0.0, change = 0.0, max_change = 0.0;
+  };
   const Model& model_;
   Reformulation& reformulation_;
   long every_, n_steps_;
   double max_err_H_, roughness_warn_, spread_growth_warn_;
   Track tracks_[3];  // H, I, m
+  std::vector<Declared> declared_;
   Vector u_;
   long steps_ = 0;
   double t_ = 0.0, roughness_max_ = 0.0, spread_max_ = 0.0, spread_baseline_ = 0.0;

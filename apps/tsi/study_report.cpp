@@ -4,6 +4,7 @@
 #include <sys/utsname.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -28,6 +29,19 @@ const std::set<std::string> covered = {"model.name", "scheme.name", "reformulati
                                        "time.h", "time.t_end", "reformulation.n_tau"};
 
 Json number_or_null(const Json& j, const Json::json_pointer& p) { return j.contains(p) ? j.at(p) : Json(); }
+
+// The change columns of the invariants the models declare (err_<name>, abs_err_<name>; see
+// RunRecorder), as the rows carry them, in order of appearance.
+std::vector<std::string> invariant_columns(const Json& rows) {
+  std::vector<std::string> out;
+  for (const auto& row : rows)
+    for (const auto& [key, value] : row.items())
+      if ((key.rfind("err_", 0) == 0 || key.rfind("abs_err_", 0) == 0) &&
+          std::find(columns.begin(), columns.end(), key) == columns.end() &&
+          std::find(out.begin(), out.end(), key) == out.end())
+        out.push_back(key);
+  return out;
+}
 
 // Everything that makes a series: a run's row without its h and the measured values.
 std::string series_key(const Json& row, bool without_eps) {
@@ -134,6 +148,10 @@ Json study_rows(const Study& study, const std::vector<RunOutcome>& outcomes) {
       const double slope = drift_slope(outcomes[i].csv, std::string("err_") + x, 0.1 * t_end);
       row[std::string("drift_") + x] = std::isfinite(slope) ? Json(slope) : Json();
     }
+    // The model's own invariants: the largest change, under the name of its column in invariants.csv.
+    if (r.contains("invariants"))
+      for (const auto& [name, inv] : r["invariants"].items())
+        if (inv.contains("column")) row[inv["column"].get<std::string>()] = inv.value("max_change", Json());
     Json varied = Json::object();
     for (const auto& [path, value] : run.assignments.items())
       if (!covered.count(path)) varied[path] = value;
@@ -244,12 +262,15 @@ void write_study_files(const std::string& dir, const Study& study, const std::ve
   std::vector<std::string> extra;
   for (const auto& path : study.varied)
     if (!covered.count(path)) extra.push_back(path);
+  const std::vector<std::string> declared = invariant_columns(rows);
   std::string csv;
   for (const auto& c : columns) csv += c + ",";
+  for (const auto& c : declared) csv += c + ",";
   for (const auto& p : extra) csv += p + ",";
   csv += "message\n";
   for (const auto& row : rows) {
     for (const auto& c : columns) csv += csv_field(row[c]) + ",";
+    for (const auto& c : declared) csv += csv_field(row.value(c, Json())) + ",";
     for (const auto& p : extra) csv += csv_field(row["varied"].value(p, Json())) + ",";
     csv += csv_field(row["message"]) + "\n";
   }
@@ -334,18 +355,27 @@ std::string study_text(const Study& study, const Json& rows) {
     }
   } else {
     const bool conservation = study.kind == "conservation";
-    s += conservation ? fmt::format("\n  {:<24}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}{:>11}  {}\n", "scheme", "eps", "h",
-                                    "max err_H", "drift_H", "max err_I", "max err_m", "t reached", "status")
+    // Conservation: a column more per invariant the models declare.
+    const std::vector<std::string> declared = conservation ? invariant_columns(rows) : std::vector<std::string>();
+    const auto declared_width = [](const std::string& c) {
+      return static_cast<int>(std::max<size_t>(11, c.size() + 5));
+    };
+    s += conservation ? fmt::format("\n  {:<24}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}", "scheme", "eps", "h", "max err_H",
+                                    "drift_H", "max err_I", "max err_m")
                       : fmt::format("\n  {:<24}{:>10}{:>9}{:>10}{:>11}{:>12}{:>10}\n", "scheme", "eps", "h", "tol",
                                     "error", "rhs evals", "wall s");
+    if (conservation) {
+      for (const auto& c : declared) s += fmt::format("{:>{}}", "max " + c, declared_width(c));
+      s += fmt::format("{:>11}  {}\n", "t reached", "status");
+    }
     for (const auto& row : rows) {
       std::string name = row["label"].get<std::string>().empty() ? row["scheme"].get<std::string>()
                                                                  : row["label"].get<std::string>();
       if (conservation) {
-        s += fmt::format("  {:<24}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}{:>11}  {}\n", name,
-                         fraction(row["eps"]), fraction(row["h"]), cell(row["err_H"]), cell(row["drift_H"], "{:.2e}"),
-                         cell(row["err_I"]), cell(row["err_m"]), cell(row["t_reached"], "{:g}"),
-                         row["status"].get<std::string>());
+        s += fmt::format("  {:<24}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}", name, fraction(row["eps"]), fraction(row["h"]),
+                         cell(row["err_H"]), cell(row["drift_H"], "{:.2e}"), cell(row["err_I"]), cell(row["err_m"]));
+        for (const auto& c : declared) s += fmt::format("{:>{}}", cell(row.value(c, Json())), declared_width(c));
+        s += fmt::format("{:>11}  {}\n", cell(row["t_reached"], "{:g}"), row["status"].get<std::string>());
       } else {
         const Json tol = row["varied"].value("scheme.tol", Json());
         s += fmt::format("  {:<24}{:>10}{:>9}{:>10}{:>11}{:>12}{:>10}\n", name, fraction(row["eps"]),

@@ -9,7 +9,9 @@ namespace tsi::app {
 
 /// One row per run (the columns of table.csv), with derived quantities: the observed order
 /// against the next larger h of the same series, and the drift slopes of err_H, err_I,
-/// err_m (least squares over the last 90% of the run).
+/// err_m (least squares over the last 90% of the run). The largest change of each invariant
+/// the run's model declares is in the column it has in invariants.csv (err_P, abs_err_P, err_mu),
+/// after the fixed columns of table.csv (empty for the runs of other models).
 Json study_rows(const Study& study, const std::vector<RunOutcome>& outcomes);
 
 /// Per-series convergence data: h, errors, successive and least-squares orders, and the

@@ -26,6 +26,11 @@ std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
       s += fmt::format("  max rel. change of {}     {:.3e}   ({:.10g} -> {:.10g})\n", name,
                        r["invariants"][name]["max_rel_error"].get<double>(),
                        r["invariants"][name]["initial"].get<double>(), r["invariants"][name]["final"].get<double>());
+    for (const auto& [name, inv] : r["invariants"].items())  // the model's own (those with a "change")
+      if (inv.contains("change"))
+        s += fmt::format("  {:<24} {:.3e}   ({:.10g} -> {:.10g})\n",
+                         fmt::format("max {} change of {}", inv["change"] == "relative" ? "rel." : "abs.", name),
+                         inv["max_change"].get<double>(), inv["initial"].get<double>(), inv["final"].get<double>());
     const Json& sv = r["solver"];
     if (sv["stages"].get<long>() > 0)
       s += fmt::format("  fixed-point sweeps/stage  {:.2f} mean, {} max, {} not converged\n",

@@ -284,6 +284,84 @@ TEST_CASE("cpd: over T = 200 at eps = 0.5, SE1 keeps the energy error small whil
   CHECK(me > 1.0);
 }
 
+namespace {
+
+// The magnetic moment from physical variables: the field strength is 1/eps, the gyration
+// velocity w = v - v_E is measured from the E x B drift v_E = eps B g(x) (the v with
+// (1/eps) B v + g = 0), g = -grad U, B a = (a2, -a1): mu = eps |w|^2 / 2.
+double magnetic_moment(const Vector& x, double eps, bool coulomb) {
+  const double x1 = x(0).real(), x2 = x(1).real(), v1 = x(2).real(), v2 = x(3).real();
+  const double k = coulomb ? 1.0 / std::pow(x1 * x1 + x2 * x2, 1.5) : -1.0;  // g = k x
+  const double w1 = v1 - eps * k * x2, w2 = v2 + eps * k * x1;
+  return 0.5 * eps * (w1 * w1 + w2 * w2);
+}
+
+}  // namespace
+
+TEST_CASE("cpd: the declared magnetic moment mu, adiabatic: O(eps^2) relative change over long SE1 runs") {
+  auto& h = Harness::instance();
+  for (const char* potential : {"coulomb", "harmonic"})
+    for (double eps : {1.0, 0.1, 1e-3}) {
+      auto model = h.model_with("cpd", eps, {{"potential", potential}});
+      const auto invariants = model->invariants();
+      REQUIRE(invariants.size() == 1);
+      CHECK(invariants[0].name == "mu");
+      CHECK(tsi::test::contains(invariants[0].description, "adiabatic"));
+      Vector u = model->initial_value();
+      u(2) += 0.3;  // away from the default data too
+      CAPTURE(potential);
+      CAPTURE(eps);
+      // Both go through p + B q = 2 eps v: rounding of 1e-16 / eps relative.
+      for (const Vector& state : {model->initial_value(), u})
+        CHECK(invariants[0].value(state) ==
+              doctest::Approx(magnetic_moment(model->to_physical(state), eps, potential == std::string("coulomb")))
+                  .epsilon(1e-14 / eps));
+    }
+
+  // SE1 on the two-scale problem (N_tau = 64, h = 1/5) over T = 2000, the Coulomb field.
+  // Measured: mu changes by 2.0e-4 at eps = 0.01 and 2.0e-6 at eps = 0.001 (2.0 eps^2, a
+  // ratio of 101), without drift; the exact solution (rk78) changes it by 1.7 eps^2 over
+  // t = 10. eps |v|^2 / 2 = I / 2, the moment without the drift, changes by 1.8 eps.
+  struct Changes {
+    double mu = 0.0, mu_first_half = 0.0, I = 0.0;
+  };
+  const auto se1_changes = [&](double eps) {
+    auto model = h.model("cpd", eps);
+    auto two_scale = h.reformulation("two-scale", model, {{"n_tau", 64}, {"initial_data_order", 2}});
+    auto se1 = h.scheme("se1");
+    const auto mu = model->invariants()[0].value;
+    const Vector u0 = model->initial_value();
+    const double mu0 = mu(u0), I0 = model->oscillatory_energy(u0);
+    Changes c;
+    Vector y = two_scale->prepare(u0);
+    tsi::integrate(*two_scale, *se1, y, 0.2, 10000, [&](long n, double t, const Vector& state) {
+      const Vector u = two_scale->read_back(state, t);
+      c.mu = std::max(c.mu, std::abs(mu(u) - mu0) / mu0);
+      c.I = std::max(c.I, std::abs(model->oscillatory_energy(u) - I0) / I0);
+      if (n == 5000) c.mu_first_half = c.mu;
+      return true;
+    });
+    return c;
+  };
+  const Changes coarse = se1_changes(0.01), fine = se1_changes(0.001);
+  const double ratio = coarse.mu / fine.mu;
+  CAPTURE(coarse.mu);
+  CAPTURE(fine.mu);
+  CAPTURE(ratio);
+  CAPTURE(coarse.I);
+  CAPTURE(fine.I);
+  CHECK(coarse.mu < 3.0 * 0.01 * 0.01);  // C eps^2 with C = 3 (measured 2.0)
+  CHECK(fine.mu < 3.0 * 0.001 * 0.001);
+  CHECK(ratio > 50.0);  // eps ten times smaller: the change about a hundred times (101)
+  CHECK(ratio < 200.0);
+  CHECK(coarse.mu < 1.5 * coarse.mu_first_half);  // no drift over the second half
+  CHECK(fine.mu < 1.5 * fine.mu_first_half);
+  // The moment without the drift correction oscillates by O(eps): mu is the better invariant.
+  CHECK(coarse.I > 1.0 * 0.01);
+  CHECK(coarse.I < 3.0 * 0.01);
+  CHECK(coarse.I > 30.0 * coarse.mu);
+}
+
 TEST_CASE("cpd: the example cpd-se1.json runs and meets its reference") {
   const tsi::test::TempDir dir("tsi-cpd-example");
   const auto r = tsi::test::run_tsi({"run", tsi::test::example_config("cpd-se1.json"), "--out", dir / "out"});

@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -409,4 +410,60 @@ TEST_CASE("run: U's characteristics coming apart is reported, and the largest sp
   const Json kept = read_json(fs::path(out) / "result.json");
   CHECK(kept.at("invariants").at("m").at("max_rel_error").get<double>() < 1e-4);
   CHECK(kept.at("tau_spread_max").get<double>() < 1e-6);
+}
+
+TEST_CASE("run: nls records its momentum P in invariants.csv and result.json, relatively or absolutely") {
+  TempDir dir;
+  const std::string out = dir / "out";
+  const std::vector<std::string> nls = {"--set", "reference=null", "--set", "reformulation.n_tau=64",
+                                        "--set", "time.h=0.25"};
+  std::vector<std::string> args = {"run", example_config("nls-se1.json"), "--out", out};
+  args.insert(args.end(), nls.begin(), nls.end());
+  const CommandResult r = run_tsi(args);
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  CHECK(contains(r.out, "max rel. change of P"));
+
+  const auto lines = lines_of(read_text(fs::path(out) / "invariants.csv"));
+  REQUIRE(lines.size() == 1 + 5);
+  CHECK(lines[0] == "t,H,I,m,err_H,err_I,err_m,tau_roughness,P,err_P");
+  double largest = 0.0;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    INFO("row " << i << ": " << lines[i]);
+    const auto fields = csv_fields(lines[i]);
+    REQUIRE(fields.size() == 10);
+    largest = std::max(largest, std::stod(fields[9]));
+  }
+  CHECK(std::stod(csv_fields(lines[1])[9]) < 1e-14);
+
+  const Json result = read_json(fs::path(out) / "result.json");
+  const Json& P = result.at("invariants").at("P");
+  INFO(P.dump(2));
+  CHECK(P.at("change") == "relative");
+  CHECK(P.at("column") == "err_P");
+  CHECK(contains(P.at("description").get<std::string>(), "momentum"));
+  CHECK(P.at("initial").get<double>() == doctest::Approx(std::stod(csv_fields(lines[1])[8])).epsilon(1e-15));
+  CHECK(P.at("final").get<double>() == doctest::Approx(std::stod(csv_fields(lines.back())[8])).epsilon(1e-15));
+  CHECK(P.at("max_change").get<double>() == doctest::Approx(largest).epsilon(1e-6));
+  CHECK(P.at("max_change").get<double>() > 0.0);
+  // The paper's u0 = e^{ix} / (1 + sin^2 x) carries momentum close to its mass.
+  CHECK(P.at("initial").get<double>() ==
+        doctest::Approx(result.at("invariants").at("m").at("initial").get<double>()).epsilon(1e-4));
+
+  // Real data, u0 = cos x, has no momentum: its change is absolute, and the column says so.
+  Json samples = Json::array();
+  for (int j = 0; j < 16; ++j) samples.push_back(std::cos(std::numbers::pi * j / 8.0));
+  args.push_back("--set");
+  args.push_back("model.u0=" + samples.dump());
+  const CommandResult real = run_tsi(args);
+  INFO(real.describe());
+  REQUIRE(real.exit_code == 0);
+  CHECK(contains(real.out, "max abs. change of P"));
+  CHECK(lines_of(read_text(fs::path(out) / "invariants.csv"))[0] ==
+        "t,H,I,m,err_H,err_I,err_m,tau_roughness,P,abs_err_P");
+  const Json zero = read_json(fs::path(out) / "result.json").at("invariants").at("P");
+  CHECK(zero.at("change") == "absolute");
+  CHECK(zero.at("column") == "abs_err_P");
+  CHECK(std::abs(zero.at("initial").get<double>()) < 1e-15);
+  CHECK(zero.at("max_change").get<double>() < 1e-13);
 }

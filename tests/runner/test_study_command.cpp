@@ -107,6 +107,46 @@ TEST_CASE("study: a completed run's warnings are listed, and kept in study.json"
   CHECK(study["table"][1]["warnings"].empty());
 }
 
+TEST_CASE("study: the invariants a model declares get a column of their largest change") {
+  TempDir dir;
+  const Json spec = {{"kind", "conservation"},
+                     {"base", {{"model", {{"eps", 0.1}}}, {"time", {{"t_end", 1.0}, {"h", 0.25}}}}},
+                     {"vary", {{"model.name", {"nls", "henon-heiles"}}}}};
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"study", write_config(dir, spec, "study.json"), "--out", out, "--no-plots"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  CHECK(contains(r.out, "max err_P"));
+  const auto lines = lines_of(read_text(fs::path(out) / "table.csv"));
+  REQUIRE(lines.size() == 3);
+  const auto header = csv_fields(lines[0]);
+  // After the fixed columns (which keep their places), before the message.
+  const auto at = [&header](const std::string& c) {
+    return std::find(header.begin(), header.end(), c) - header.begin();
+  };
+  REQUIRE(at("err_P") < static_cast<long>(header.size()));
+  CHECK(at("err_P") == at("status") + 1);
+  CHECK(header.back() == "message");
+  const Json study = read_json(fs::path(out) / "study.json");
+  REQUIRE(study["table"].size() == 2);
+  for (size_t i = 0; i < 2; ++i) {
+    const Json& row = study["table"][i];
+    const auto fields = csv_fields(lines[i + 1]);
+    REQUIRE(fields.size() == header.size());
+    const std::string cell = fields[static_cast<size_t>(at("err_P"))];
+    if (row["model"] == "nls") {
+      const Json result = read_json(fs::path(out) / "runs" / row["id"].get<std::string>() / "result.json");
+      const double max_change = result["invariants"]["P"]["max_change"];
+      CHECK(max_change > 0.0);
+      CHECK(row["err_P"].get<double>() == max_change);
+      CHECK(std::stod(cell) == doctest::Approx(max_change).epsilon(1e-9));
+    } else {
+      CHECK_FALSE(row.contains("err_P"));
+      CHECK(cell.empty());
+    }
+  }
+}
+
 TEST_CASE("study: a bad path is rejected before any run, naming the run and the path") {
   TempDir dir;
   Json spec = small_study();

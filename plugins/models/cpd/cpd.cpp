@@ -14,6 +14,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "tsi/error.hpp"
 #include "tsi/model.hpp"
@@ -175,6 +176,33 @@ class ChargedParticle final : public tsi::Model {
     Vector field = nonlinear_field(u);
     u(2) += t * field(2);
     u(3) += t * field(3);
+  }
+
+  // The magnetic moment mu = |w|^2 / (2 |B|) of the gyration, field strength |B| = 1/eps, with the
+  // gyration velocity w = v - v_E measured from the E x B drift v_E = eps B g(x), the velocity
+  // at which (1/eps) B v_E + g = 0. In the canonical variables (2 eps v = p + B q):
+  //     mu = eps |v - eps B g(q)|^2 / 2 = |p + B q - 2 eps^2 B g(q)|^2 / (8 eps).
+  // An adiabatic invariant: w' = (1/eps) B w - eps B Dg(x) v, whose second term averages to zero
+  // over a gyration (B Dg is traceless), so mu oscillates by O(eps^2) relative and does not drift.
+  // Without the drift, eps |v|^2 / 2 = I / 2 exactly, which oscillates by O(eps) (err_I).
+  double magnetic_moment(const Vector& u) const {
+    const double q1 = u(0).real(), q2 = u(1).real(), p1 = u(2).real(), p2 = u(3).real();
+    double g1 = -q1, g2 = -q2;  // g = -grad U
+    if (potential_ == Potential::Coulomb) {
+      const double r2 = q1 * q1 + q2 * q2, k = 1.0 / (r2 * std::sqrt(r2));
+      g1 = k * q1;
+      g2 = k * q2;
+    }
+    const double drift = 2.0 * eps() * eps();  // B (a, b) = (b, -a)
+    const double a1 = p1 + q2 - drift * g2, a2 = p2 - q1 + drift * g1;
+    return (a1 * a1 + a2 * a2) / (8.0 * eps());
+  }
+
+  std::vector<tsi::ModelInvariant> invariants() const override {
+    return {{"mu",
+             "magnetic moment eps |v - v_E|^2 / 2 of the gyration about the E x B drift v_E = eps B g(x); "
+             "adiabatic, not exact: O(eps^2) relative oscillations expected, no drift",
+             [this](const Vector& u) { return magnetic_moment(u); }}};
   }
 
   Vector initial_value() const override {

@@ -1,0 +1,128 @@
+// The recorder on a model whose answers are known: the harmonic oscillator u(t) = (cos(t/eps),
+// -sin(t/eps)) with invariants of its own, one starting at 0 (absolute change), one not
+// (relative change), and names it must refuse.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+
+#include "fixtures/fixture_model.hpp"
+#include "run_recorder.hpp"
+#include "tsi/error.hpp"
+#include "tsi/registry.hpp"
+
+namespace {
+
+using tsi::Json;
+using tsi::ModelInvariant;
+using tsi::Vector;
+
+class DeclaringModel final : public tsi::fixture::HarmonicModel {
+ public:
+  DeclaringModel(double eps, std::vector<ModelInvariant> invariants)
+      : HarmonicModel(eps), invariants_(std::move(invariants)) {}
+  std::vector<ModelInvariant> invariants() const override { return invariants_; }
+
+ private:
+  std::vector<ModelInvariant> invariants_;
+};
+
+// u(t) = (cos t, -sin t) at eps = 1: "Q" = u_1^2 + 1 starts at 2 and changes by cos^2 t - 1;
+// "z" = u_2 starts at 0 and changes by |sin t|.
+std::vector<ModelInvariant> sample_invariants() {
+  return {{"Q", "u_1^2 + 1", [](const Vector& u) { return std::norm(u(0)) + 1.0; }},
+          {"z", "u_2", [](const Vector& u) { return u(1).real(); }}};
+}
+
+Json config(double h, double t_end) {
+  return {{"output", {{"every", 1}}},
+          {"monitor", {{"max_err_H", 1e10}, {"tau_roughness_warn", 1.0}, {"tau_spread_growth_warn", 1e10}}},
+          {"time", {{"h", h}, {"t_end", t_end}}}};
+}
+
+struct Setup {
+  std::shared_ptr<const tsi::Model> model;
+  std::unique_ptr<tsi::Reformulation> direct;
+  explicit Setup(std::vector<ModelInvariant> invariants)
+      : model(std::make_shared<DeclaringModel>(1.0, std::move(invariants))) {
+    tsi::Registry registry;
+    tsi::register_core(registry);
+    const auto& entry = registry.reformulation("direct");
+    direct = entry.create(model, tsi::Params(tsi::resolve_params(entry.info.params, Json::object(), "r")));
+  }
+};
+
+Vector exact(double t) {
+  Vector u(2);
+  u << std::cos(t), -std::sin(t);
+  return u;
+}
+
+}  // namespace
+
+TEST_CASE("recorder: a declared invariant gets a value and a change column, relative or absolute") {
+  Setup s(sample_invariants());
+  tsi::app::RunRecorder recorder(*s.model, *s.direct, exact(0.0), config(0.5, 1.0));
+  for (long n = 0; n <= 2; ++n) {
+    const double t = 0.5 * static_cast<double>(n);
+    REQUIRE(recorder.observe(n, t, exact(t)));
+  }
+  const std::string csv = recorder.csv();
+  CHECK(csv.substr(0, csv.find('\n')) == "t,H,I,m,err_H,err_I,err_m,tau_roughness,Q,err_Q,z,abs_err_z");
+
+  const Json inv = recorder.invariants_json();
+  CHECK(inv["Q"]["change"] == "relative");
+  CHECK(inv["Q"]["column"] == "err_Q");
+  CHECK(inv["Q"]["description"] == "u_1^2 + 1");
+  CHECK(inv["Q"]["initial"].get<double>() == 2.0);
+  CHECK(inv["Q"]["final"].get<double>() == doctest::Approx(std::pow(std::cos(1.0), 2) + 1.0).epsilon(1e-15));
+  CHECK(inv["Q"]["max_change"].get<double>() == doctest::Approx(std::pow(std::sin(1.0), 2) / 2.0).epsilon(1e-14));
+  CHECK(inv["z"]["change"] == "absolute");
+  CHECK(inv["z"]["column"] == "abs_err_z");
+  CHECK(inv["z"]["initial"].get<double>() == 0.0);
+  CHECK(inv["z"]["max_change"].get<double>() == doctest::Approx(std::sin(1.0)).epsilon(1e-15));
+  // H, I, m keep their entries.
+  for (const char* name : {"H", "I", "m"}) CHECK(inv[name].contains("max_rel_error"));
+
+  // The last row: t = 1, the values and their changes at the end of the columns.
+  const std::string last = csv.substr(csv.rfind('\n', csv.size() - 2) + 1);
+  std::vector<double> fields;
+  for (size_t pos = 0; pos < last.size();) {
+    const size_t comma = last.find(',', pos);
+    fields.push_back(std::stod(last.substr(pos, comma - pos)));
+    pos = comma == std::string::npos ? last.size() : comma + 1;
+  }
+  REQUIRE(fields.size() == 12);
+  CHECK(fields[0] == 1.0);
+  CHECK(fields[8] == doctest::Approx(std::pow(std::cos(1.0), 2) + 1.0).epsilon(1e-15));
+  CHECK(fields[9] == doctest::Approx(std::pow(std::sin(1.0), 2) / 2.0).epsilon(1e-6));
+  CHECK(fields[10] == doctest::Approx(-std::sin(1.0)).epsilon(1e-15));
+  CHECK(fields[11] == doctest::Approx(std::sin(1.0)).epsilon(1e-6));
+}
+
+TEST_CASE("recorder: an initial value at the threshold is changed absolutely, above it relatively") {
+  const double threshold = tsi::app::RunRecorder::relative_change_threshold;
+  for (const auto& [initial, kind] : {std::pair{threshold, "absolute"}, std::pair{2.0 * threshold, "relative"},
+                                      std::pair{-2.0 * threshold, "relative"}}) {
+    Setup s({{"c", "a constant", [v = initial](const Vector&) { return v; }}});
+    tsi::app::RunRecorder recorder(*s.model, *s.direct, exact(0.0), config(1.0, 1.0));
+    CAPTURE(initial);
+    CHECK(recorder.invariants_json()["c"]["change"] == kind);
+  }
+}
+
+TEST_CASE("recorder: invariant names that are no column names, or whose columns are taken, are refused") {
+  for (const std::string name : {"", "a b", "x,y", "H", "m", "t", "err_H", "tau_roughness"}) {
+    CAPTURE(name);
+    Setup s({{name, "", [](const Vector&) { return 1.0; }}});
+    CHECK_THROWS_AS(tsi::app::RunRecorder(*s.model, *s.direct, exact(0.0), config(1.0, 1.0)), tsi::Error);
+  }
+  // Two invariants with the same name, or one named as another's change column.
+  Setup twice({{"P", "", [](const Vector&) { return 1.0; }}, {"P", "", [](const Vector&) { return 2.0; }}});
+  CHECK_THROWS_AS(tsi::app::RunRecorder(*twice.model, *twice.direct, exact(0.0), config(1.0, 1.0)), tsi::Error);
+  Setup column({{"P", "", [](const Vector&) { return 1.0; }}, {"err_P", "", [](const Vector&) { return 2.0; }}});
+  CHECK_THROWS_AS(tsi::app::RunRecorder(*column.model, *column.direct, exact(0.0), config(1.0, 1.0)), tsi::Error);
+  Setup missing(std::vector<ModelInvariant>{{"P", "", nullptr}});
+  CHECK_THROWS_WITH_AS(tsi::app::RunRecorder(*missing.model, *missing.direct, exact(0.0), config(1.0, 1.0)),
+                       doctest::Contains("without a value function"), tsi::Error);
+}
