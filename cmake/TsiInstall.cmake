@@ -32,3 +32,8 @@ install(FILES ${PROJECT_BINARY_DIR}/cmake/tsiConfig.cmake ${PROJECT_BINARY_DIR}/
 
 # The plotting script `tsi study` calls, found next to an installed runner (share/tsi).
 install(FILES ${PROJECT_SOURCE_DIR}/scripts/plot_study.py DESTINATION ${CMAKE_INSTALL_DATADIR}/tsi OPTIONAL)
+# The documents a plugin author works from, next to the headers they describe: the formulas
+# and numbers (SPEC.md), writing a model or a scheme, and the plugin ABI.
+install(FILES ${PROJECT_SOURCE_DIR}/docs/SPEC.md ${PROJECT_SOURCE_DIR}/docs/writing-a-model.md
+              ${PROJECT_SOURCE_DIR}/docs/writing-a-scheme.md ${PROJECT_SOURCE_DIR}/docs/plugin-abi.md
+        DESTINATION ${CMAKE_INSTALL_DOCDIR})
