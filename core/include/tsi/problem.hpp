@@ -17,8 +17,6 @@ class TSI_API Problem {
   /// The diagonal of L, or an empty vector when L is not diagonal in these coordinates.
   virtual const Vector& linear_multipliers() const = 0;
   bool has_diagonal_linear_part() const { return linear_multipliers().size() == size(); }
-  /// True when N does not depend on t.
-  virtual bool autonomous() const = 0;
   /// The period in t of the fastest component of the explicit time dependence (filtered:
   /// 2 pi eps / Model::max_linear_frequency()), 0 if none.
   /// Adaptive solvers must not step across it: their error estimates alias.

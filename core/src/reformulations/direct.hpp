@@ -20,7 +20,6 @@ class Direct final : public Reformulation {
 
   Index size() const override { return size_; }
   const Vector& linear_multipliers() const override { return none_; }
-  bool autonomous() const override { return true; }
   void nonlinear(double t, const Vector& y, Vector& out) override;
   void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
   void rhs(double t, const Vector& y, Vector& out) override;

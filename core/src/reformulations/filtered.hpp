@@ -13,7 +13,6 @@ class Filtered final : public Reformulation {
 
   Index size() const override { return model_->dim(); }
   const Vector& linear_multipliers() const override { return multipliers_; }
-  bool autonomous() const override { return false; }
   /// The shortest period of the explicit time dependence: 2 pi eps over the model's
   /// largest linear frequency (2 pi eps for Henon-Heiles; 2 pi eps / 64 for NLS with N_x = 16).
   double fast_period() const override { return two_pi * model_->eps() / model_->max_linear_frequency(); }

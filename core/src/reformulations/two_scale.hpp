@@ -15,7 +15,6 @@ class TwoScale final : public Reformulation {
 
   Index size() const override { return dim_ * n_tau_; }
   const Vector& linear_multipliers() const override { return multipliers_; }
-  bool autonomous() const override { return true; }
   void nonlinear(double t, const Vector& y, Vector& out) override;
   void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
   void rhs(double t, const Vector& y, Vector& out) override;
