@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "harness.hpp"
+#include "runner/run_command.hpp"
 #include "tsi/convergence.hpp"
 
 namespace {
@@ -464,4 +465,46 @@ TEST_CASE("klein-gordon: FD's error on the linear equation is Crank-Nicolson's p
       CHECK((computed - model->to_physical(crank_nicolson)).norm() < 1e-12 * computed.norm());
     }
   }
+}
+
+TEST_CASE("klein-gordon: the example kg-se1.json runs, and a user's u0 is read as samples of v") {
+  const tsi::test::TempDir dir("tsi-kg-example");
+  tsi::Json config = tsi::Json::parse(tsi::test::read_text(tsi::test::example_config("kg-se1.json")));
+  const auto plain =
+      tsi::test::run_tsi({"run", tsi::test::write_config(dir, config, "a.json"), "--out", dir / "a"});
+  REQUIRE_MESSAGE(plain.exit_code == 0, plain.describe());
+  const auto result = tsi::test::read_json(dir.path() / "a" / "result.json");
+  CHECK(result.at("status") == "completed");
+  REQUIRE(result.at("u_final").size() == n_x);
+  const double error = result.at("error").at("relative");
+  CHECK(error > 1e-4);  // measured: 5.5e-4 (SE1, eps = 1e-3, h = 1/16)
+  CHECK(error < 1e-3);
+
+  // u0 = the default v0, given explicitly: the same run to rounding.
+  tsi::Json samples = tsi::Json::array();
+  const Vector v0 = default_v0();
+  for (long j = 0; j < n_x; ++j) samples.push_back({v0(j).real(), v0(j).imag()});
+  config.erase("reference");
+  config["model"]["u0"] = samples;
+  const auto given =
+      tsi::test::run_tsi({"run", tsi::test::write_config(dir, config, "b.json"), "--out", dir / "b"});
+  REQUIRE_MESSAGE(given.exit_code == 0, given.describe());
+  const auto a = result.at("u_final");
+  const auto b = tsi::test::read_json(dir.path() / "b" / "result.json").at("u_final");
+  REQUIRE(a.size() == b.size());
+  for (size_t j = 0; j < a.size(); ++j)
+    for (size_t k = 0; k < 2; ++k) CHECK(std::abs(a[j][k].get<double>() - b[j][k].get<double>()) < 1e-13);
+  // A wrong number of samples is bad input, naming the field.
+  config["model"]["u0"] = tsi::Json::array({{1.0, 0.0}, {0.0, 1.0}});
+  const auto wrong =
+      tsi::test::run_tsi({"run", tsi::test::write_config(dir, config, "c.json"), "--out", dir / "c"});
+  CHECK(wrong.exit_code == 2);
+  CHECK(tsi::test::contains(wrong.err, "model.u0"));
+  // n_x must be even.
+  config["model"].erase("u0");
+  config["model"]["n_x"] = 15;
+  const auto odd =
+      tsi::test::run_tsi({"run", tsi::test::write_config(dir, config, "d.json"), "--out", dir / "d"});
+  CHECK(odd.exit_code == 2);
+  CHECK(tsi::test::contains(odd.err, "model.n_x"));
 }
