@@ -350,11 +350,11 @@ tsi::Json tight(const tsi::SchemeEntry& scheme) {
   return params;
 }
 
-// u(1) in physical variables by a two-scale scheme with `steps` steps, the model's default
-// n_tau (32) and the prepared data the scheme declares it needs.
-Vector two_scale_solution(const tsi::SchemeEntry& scheme, double eps, long steps) {
+// u(1) in physical variables by a two-scale scheme with `steps` steps on `grid` points, the
+// model's default n_tau (32) and the prepared data the scheme declares it needs.
+Vector two_scale_solution(const tsi::SchemeEntry& scheme, double eps, long steps, int grid = n_x) {
   auto& h = Harness::instance();
-  auto model = h.model("klein-gordon", eps);
+  auto model = h.model_with("klein-gordon", eps, {{"n_x", grid}});
   auto two_scale = h.reformulation(
       "two-scale", model,
       {{"n_tau", h.registry().model("klein-gordon").default_n_tau},
@@ -365,72 +365,85 @@ Vector two_scale_solution(const tsi::SchemeEntry& scheme, double eps, long steps
 
 // The reference u(1): rk78 on the filtered problem (tol 1e-13), or, at eps = 1e-6 where that
 // takes 10 s, SE1 with h = 1/4096 (its error there is about 1e-8, checked at eps = 1e-4 below).
-const Vector& kg_reference(double eps) {
-  static std::map<double, Vector> cache;
-  if (auto it = cache.find(eps); it != cache.end()) return it->second;
-  if (eps >= 1e-4) return cache[eps] = tsi::test::reference_solution("klein-gordon", eps, 1.0);
-  return cache[eps] = two_scale_solution(Harness::instance().registry().scheme("se1"), eps, 4096);
+const Vector& kg_reference(double eps, int grid = n_x) {
+  static std::map<std::pair<double, int>, Vector> cache;
+  const auto key = std::make_pair(eps, grid);
+  if (auto it = cache.find(key); it != cache.end()) return it->second;
+  auto& h = Harness::instance();
+  if (eps < 1e-4) return cache[key] = two_scale_solution(h.registry().scheme("se1"), eps, 4096, grid);
+  auto model = h.model_with("klein-gordon", eps, {{"n_x", grid}});
+  auto filtered = h.reformulation("filtered", model);
+  auto rk78 = h.scheme("rk78", {{"tol", 1e-13}});
+  return cache[key] = tsi::test::solve(*model, *filtered, *rk78, 1.0, 1);
 }
 
-double kg_error(const tsi::SchemeEntry& scheme, double eps, long steps) {
-  auto model = Harness::instance().model("klein-gordon", eps);
-  const Vector& ref = kg_reference(eps);
-  return model->error_norm(two_scale_solution(scheme, eps, steps) - ref) / model->error_norm(ref);
+double kg_error(const tsi::SchemeEntry& scheme, double eps, long steps, int grid = n_x) {
+  auto model = Harness::instance().model_with("klein-gordon", eps, {{"n_x", grid}});
+  const Vector& ref = kg_reference(eps, grid);
+  return model->error_norm(two_scale_solution(scheme, eps, steps, grid) - ref) / model->error_norm(ref);
 }
 
 }  // namespace
 
 TEST_CASE("klein-gordon: the small-step SE1 reference agrees with rk78 at eps = 1e-4") {
   auto& h = Harness::instance();
-  auto model = h.model("klein-gordon", 1e-4);
-  const Vector& ref = tsi::test::reference_solution("klein-gordon", 1e-4, 1.0);
-  const Vector se1 = two_scale_solution(h.registry().scheme("se1"), 1e-4, 4096);
-  const double difference = model->error_norm(se1 - ref) / model->error_norm(ref);
-  CAPTURE(difference);
-  CHECK(difference < 2e-8);  // measured: 7.6e-9 (SE1's error ~ 1.95e-6 (256 / 4096)^2)
+  for (int grid : {n_x, 64}) {
+    auto model = h.model_with("klein-gordon", 1e-4, {{"n_x", grid}});
+    const Vector& ref = kg_reference(1e-4, grid);
+    const Vector se1 = two_scale_solution(h.registry().scheme("se1"), 1e-4, 4096, grid);
+    const double difference = model->error_norm(se1 - ref) / model->error_norm(ref);
+    CAPTURE(grid);
+    CAPTURE(difference);
+    CHECK(difference < 2e-8);  // measured: 7.6e-9 (SE1's error ~ 1.95e-6 (256 / 4096)^2)
+  }
 }
 
 TEST_CASE("klein-gordon: every two-scale scheme is uniformly second order at T = 1") {
-  // n_x = 16, eps from 1 to 1e-6. The error is largest in the limit eps -> 0, where the remainder
-  // frequencies A_k tend to k^2 / 2 (up to 32 at n_x = 16), and the modes that carry it (k = 4 .. 6,
-  // amplitudes 3e-2 .. 5e-3 for the default u0) need h A_k <~ 1: below h = 1/8 the orders are 1.3
-  // (SE1) to 0.7 (ME), with u0 = cos x - (i/2) sin x they are 2.0 from h = 1/2 on. So the orders are
-  // fitted on h = 1/16 .. 1/128 (measured 1.95 .. 2.21). FD treats L = -(1/eps) d/dtau + J R by the
-  // Crank-Nicolson fraction, whose phase error on the remainder, (h A_k)^3 / 12 per step, is all of
-  // its error at lambda = 0 (the next test); it is fitted on h = 1/32 .. 1/256 (1.83 .. 2.00).
-  // eps = 1e-2 is left out of the fit: h = 1/16 and 1/32 are there within 1% of 2 and 1 half fast
-  // periods pi eps, the step-size resonance Henon-Heiles shows at the same eps
-  // (docs/writing-a-model.md); SE1's error at h = 1/32 is 10 times the limit's there.
+  // n_x = 16 and 64, eps from 1 to 1e-6. The error is largest in the limit eps -> 0, where the remainder
+  // frequencies A_k tend to k^2 / 2 (up to 32 at n_x = 16), and the modes of the default u0 that
+  // carry it (k = 3, 5, 7: amplitudes 0.11, 0.018, 0.003, A_k = 4.5, 12.5, 24.5) need h A_k <~ 1.
+  // From h = 1/4 to 1/8 the orders are 1.8 (SE1), 1.5 (SE2) and 1.3 (ME); with u0 = cos x -
+  // (i/2) sin x SE1's order is 2.0 from h = 1/2 on. So the orders are fitted on h = 1/16 .. 1/128
+  // (measured 1.94 .. 2.21). FD treats L = -(1/eps) d/dtau + J R by the Crank-Nicolson fraction,
+  // whose phase error on the remainder, (h A_k)^3 / 12 per step, is all of its error at lambda = 0
+  // (the next test); it is fitted on h = 1/32 .. 1/256 (1.83 .. 2.00).
+  // eps = 1e-2 is left out: h = 1/16 and 1/32 are there within 1% of 2 and 1 half fast periods
+  // pi eps, the step-size resonance Henon-Heiles shows at the same eps (docs/writing-a-model.md);
+  // SE1's error at h = 1/32 is 10 times the limit's there.
   const std::vector<double> epsilons = {1.0, 1.0 / 16, 1e-4, 1e-6};
-  for (const auto* scheme : tsi::test::two_scale_schemes()) {
-    const std::vector<long> steps = scheme->info.name == "fd" ? std::vector<long>{32, 64, 128, 256}
-                                                               : std::vector<long>{16, 32, 64, 128};
-    std::vector<double> hs;
-    for (long n : steps) hs.push_back(1.0 / static_cast<double>(n));
-    std::vector<std::vector<double>> errors;
-    for (double eps : epsilons) {
-      errors.emplace_back();
-      for (long n : steps) errors.back().push_back(kg_error(*scheme, eps, n));
-      const double order = tsi::least_squares_order(hs, errors.back());
-      CAPTURE(scheme->info.name);
-      CAPTURE(eps);
-      CAPTURE(errors.back().front());
-      CAPTURE(errors.back().back());
-      CAPTURE(order);
-      CHECK(std::abs(order - 2.0) <= 0.3);
-    }
-    for (size_t i = 0; i < hs.size(); ++i) {
-      // Uniform in eps: the error at fixed h tends to a limit as eps -> 0 (eps = 1e-4 and 1e-6:
-      // measured within 0.7%), and no eps has a larger error than the limit (no blow-up, no growth).
-      double largest = 0.0;
-      for (const auto& e : errors) largest = std::max(largest, e[i]);
-      CAPTURE(scheme->info.name);
-      CAPTURE(hs[i]);
-      CAPTURE(largest);
-      CAPTURE(errors[2][i]);
-      CAPTURE(errors[3][i]);
-      CHECK(std::abs(errors[2][i] / errors[3][i] - 1.0) < 0.02);
-      CHECK(largest <= 1.02 * errors[3][i]);
+  for (int grid : {n_x, 64}) {
+    for (const auto* scheme : tsi::test::two_scale_schemes()) {
+      const std::vector<long> steps = scheme->info.name == "fd" ? std::vector<long>{32, 64, 128, 256}
+                                                                 : std::vector<long>{16, 32, 64, 128};
+      std::vector<double> hs;
+      for (long n : steps) hs.push_back(1.0 / static_cast<double>(n));
+      std::vector<std::vector<double>> errors;
+      for (double eps : epsilons) {
+        errors.emplace_back();
+        for (long n : steps) errors.back().push_back(kg_error(*scheme, eps, n, grid));
+        const double order = tsi::least_squares_order(hs, errors.back());
+        CAPTURE(grid);
+        CAPTURE(scheme->info.name);
+        CAPTURE(eps);
+        CAPTURE(errors.back().front());
+        CAPTURE(errors.back().back());
+        CAPTURE(order);
+        CHECK(std::abs(order - 2.0) <= 0.3);
+      }
+      for (size_t i = 0; i < hs.size(); ++i) {
+        // Uniform in eps: the error at fixed h tends to a limit as eps -> 0 (eps = 1e-4 and 1e-6:
+        // measured within 0.7%), and no eps has a larger error than the limit (no blow-up, no growth).
+        double largest = 0.0;
+        for (const auto& e : errors) largest = std::max(largest, e[i]);
+        CAPTURE(grid);
+        CAPTURE(scheme->info.name);
+        CAPTURE(hs[i]);
+        CAPTURE(largest);
+        CAPTURE(errors[2][i]);
+        CAPTURE(errors[3][i]);
+        CHECK(std::abs(errors[2][i] / errors[3][i] - 1.0) < 0.02);
+        CHECK(largest <= 1.02 * errors[3][i]);
+      }
     }
   }
 }
