@@ -4,6 +4,11 @@
 
 namespace tsi {
 
+const Vector& Problem::remainder_multipliers() const {
+  static const Vector none;
+  return none;
+}
+
 void Problem::linear_flow(double /*h*/, Vector& /*y*/) {
   throw Error("this problem has no exact linear flow (has_exact_flows() is false)");
 }

@@ -80,7 +80,8 @@ TEST_CASE("conformance: a step h then -h returns the state exactly when the sche
   };
   const std::vector<Case> cases = {{"henon-heiles", {1.0, 1e-2, 1e-6}, 0.5, 64},
                                    {"nls", {1.0, 1e-3}, 0.25, 256},
-                                   {"cpd", {1.0, 0.1}, 0.5, 64}};
+                                   {"cpd", {1.0, 0.1}, 0.5, 64},
+                                   {"klein-gordon", {1.0, 1e-3}, 0.25, 32}};
   auto& h = Harness::instance();
   for (const auto& c : cases) {
     for (const auto* scheme : two_scale_schemes()) {

@@ -17,6 +17,11 @@ class TSI_API Problem {
   /// The diagonal of L, or an empty vector when L is not diagonal in these coordinates.
   virtual const Vector& linear_multipliers() const = 0;
   bool has_diagonal_linear_part() const { return linear_multipliers().size() == size(); }
+  /// The part of linear_multipliers() that is the model's remainder J R (i omega_j on every
+  /// unknown of model coordinate j), or empty without one. A scheme that approximates e^{hL}
+  /// (FD's Crank-Nicolson fraction) integrates this part exactly instead: it is bounded in eps
+  /// but may be large, and its approximation would cost the order.
+  virtual const Vector& remainder_multipliers() const;
   /// The period in t of the fastest component of the explicit time dependence (filtered:
   /// 2 pi eps / Model::max_linear_frequency()), 0 if none.
   /// Adaptive solvers must not step across it: their error estimates alias.

@@ -40,7 +40,7 @@ Direct::Direct(std::shared_ptr<const Model> model, Variables variables)
       field_(model_->dim(), 1),
       mu_(model_->dim()),
       jmu_(model_->dim()),
-      remainder_(remainder_multipliers(*model_)) {
+      remainder_(model_remainder(*model_)) {
   if (physical_) {
     require_linear_to_physical(*model_);
     size_ = model_->to_physical(model_->initial_value()).size();

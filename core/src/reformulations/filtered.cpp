@@ -7,7 +7,7 @@ namespace tsi {
 
 Filtered::Filtered(std::shared_ptr<const Model> model)
     : Reformulation(std::move(model)),
-      multipliers_(remainder_multipliers(*model_)),
+      multipliers_(model_remainder(*model_)),
       has_remainder_(multipliers_.size() > 0),
       tau_(1),
       minus_tau_(1),

@@ -6,7 +6,7 @@
 
 namespace tsi {
 
-Vector remainder_multipliers(const Model& model) {
+Vector model_remainder(const Model& model) {
   const RealVector& omega = model.linear_remainder();
   if (omega.size() == 0) return {};
   if (omega.size() != model.dim())

@@ -15,7 +15,7 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
       data_order_(initial_data_order),
       eps_(model_->eps()),
       taus_(n_tau),
-      remainder_(remainder_multipliers(*model_)),
+      remainder_(model_remainder(*model_)),
       wave_numbers_(n_tau),
       multipliers_(dim_ * n_tau),
       fft_(n_tau, static_cast<int>(model_->dim())),
@@ -26,6 +26,7 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
   if (initial_data_order < 1 || initial_data_order > 3)
     throw ConfigError("reformulation.initial_data_order",
                       "got " + std::to_string(initial_data_order) + ", expected 1, 2 or 3");
+  if (remainder_.size()) remainder_grid_ = remainder_.replicate(n_tau, 1);
   for (int j = 0; j < n_tau; ++j) {
     taus_(j) = two_pi * j / n_tau;
     wave_numbers_(j) = j <= n_tau / 2 ? j : j - n_tau;

@@ -15,6 +15,7 @@ class TwoScale final : public Reformulation {
 
   Index size() const override { return dim_ * n_tau_; }
   const Vector& linear_multipliers() const override { return multipliers_; }
+  const Vector& remainder_multipliers() const override { return remainder_grid_; }
   void nonlinear(double t, const Vector& y, Vector& out) override;
   void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
   void rhs(double t, const Vector& y, Vector& out) override;
@@ -52,6 +53,7 @@ class TwoScale final : public Reformulation {
   std::unique_ptr<TauGridField> grid_field_;  // f_tau on taus_, bound once
   RealVector wave_numbers_;  // k of each Fourier index; the Nyquist index holds n/2
   Vector multipliers_;
+  Vector remainder_grid_;  // remainder_ on every tau point (empty without a remainder)
   FftBatch fft_;        // U's coefficients -> its values on the tau grid
   FftBatch field_fft_;  // f_tau(U) on the grid -> its coefficients: the model writes here
 };

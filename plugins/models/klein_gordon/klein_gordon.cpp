@@ -1,0 +1,313 @@
+// The nonlinear Klein-Gordon equation in the non-relativistic limit (SPEC.md section 6):
+//     e^2 z_tt - z_xx + z / e^2 + lambda z^3 = 0,   x in [0, 2 pi) periodic, z real,
+// with tsi's eps = e^2 (time is not rescaled), discretised by the Fourier pseudospectral
+// method on the grid x_j = 2 pi j / n_x (n_x even). Reference: Chartier, Crouseilles, Lemou,
+// Mehats, Numer. Math. 129 (2015) 211-250.
+//
+// Variables. q = z, p = e^2 z_t, and for the wave number k (FFT order, the Nyquist index taken
+// as k = n_x/2) a_k = (1 + eps k^2)^(1/4), Q_k = a_k q_k, P_k = p_k / a_k, w_k = Q_k - i P_k,
+// where q_k, p_k are the discrete Fourier coefficients (1/n_x) sum_j q_j e^{-i k x_j}. The state
+// is c = sqrt(2 pi) w, normalised as in the NLS model so that sum |c_k|^2 is a discrete L2 norm.
+// Every complex c is the image of exactly one real pair (q, p): since q and p are real,
+// conj(w_{-k}) = Q_k + i P_k, so Q_k = (w_k + conj(w_{-k})) / 2 and P_k = i (w_k - conj(w_{-k})) / 2
+// (at k = 0 and at the Nyquist index, Q = Re w and P = -Im w).
+//
+// The equation. q_k' = p_k / e^2 and p_k' = -(k^2 + 1/e^2) q_k - lambda (z^3)_k give, with
+// omega_k = e^-2 a_k^2 = e^-2 sqrt(1 + e^2 k^2), Q_k' = omega_k P_k and
+// P_k' = -omega_k Q_k - lambda (z^3)_k / a_k, hence
+//     w_k' = i omega_k w_k + i lambda (z^3)_k / a_k.
+// With omega_k = 1/eps + A_k and the remainder A_k = k^2 / (1 + sqrt(1 + eps k^2)) (written
+// without the cancellation of omega_k - 1/eps): J = i, M = I, J R = diag(i A_k)
+// (linear_remainder()), and the nonlinearity is J grad H1 for
+//     H1 = (lambda / 4) int z^4 dx = (lambda / 4) (2 pi / n_x) sum_j z_j^4,
+//     J grad H1 = i lambda sqrt(2 pi) / n_x * a_k^{-1} forward(z^3)_k.
+// z on the grid: g = backward(a^{-1} c) / sqrt(2 pi) = q - i (1 - e^2 d_xx)^{-1/2} p on the grid
+// (both terms are real grid functions: a_k is even in k), so z_j = Re g_j, pointwise. Then
+// H = <c, c> / (2 eps) + (1/2) sum_k A_k |c_k|^2 + H1 is the energy
+//     int e^2 z_t^2 / 2 + z_x^2 / 2 + z^2 / (2 e^2) + lambda z^4 / 4 dx
+// of the semi-discrete system (the cross terms Im(conj(Q_k) P_k) cancel between k and -k).
+//
+// Physical variables (model.u0, u_final, errors): the complex grid samples
+//     v = z - i (1 - e^2 d_xx)^{-1/2} (e^2 z_t) = g,
+// O(1) in e for well-prepared data (z = O(1), z_t = O(1/e^2)); to_physical is
+// v = backward(a^{-1} c) / sqrt(2 pi), from_physical its inverse, errors in the discrete L2 norm.
+//
+// The exact nonlinear flow: u' = J grad H1 changes p alone (p' = -lambda z^3, q fixed), since
+// a^{-1} (i a^{-1} forward(z^3)) transforms back to i times a real grid function. z, and with it
+// the field, stays constant: the flow is c <- c + t J grad H1(c).
+//
+// Default initial value (in v, so that u0 is O(1) for every eps):
+//     z(x, 0) = cos x / (1 + sin^2 x),   (1 - e^2 d_xx)^{-1/2} (e^2 z_t)(x, 0) = sin x / (2 (1 + cos^2 x)),
+// that is v0(x) = cos x / (1 + sin^2 x) - (i/2) sin x / (1 + cos^2 x): analytic and 2 pi periodic,
+// z(x, 0) the real part of the NLS paper's u0, the momentum of the same size and shape. Only odd
+// modes, decaying like e^{-0.88 |k|} (k = 3, 5, 7: 0.11, 0.018, 0.003). Well prepared uniformly
+// in eps: e^2 z_t(0) = (1 - e^2 d_xx)^{1/2} of an eps-independent smooth function is O(1).
+#include <cmath>
+#include <complex>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "tsi/error.hpp"
+#include "tsi/fft.hpp"
+#include "tsi/model.hpp"
+#include "tsi/phase.hpp"
+#include "tsi/plugin.hpp"
+
+namespace {
+
+using tsi::Complex;
+using tsi::ConstMatrixRef;
+using tsi::Index;
+using tsi::MatrixRef;
+using tsi::Vector;
+
+/// Transforms along x of `columns` states of n_x entries each, all columns in one batched
+/// transform each way (as in the NLS model: tsi::FftBatch transforms along the second index
+/// of a (howmany x n) buffer, so the states are stored transposed, one per row).
+class XBatch {
+ public:
+  XBatch(int n_x, Index columns) : fft_(n_x, static_cast<int>(columns)), scratch_(columns, n_x) {}
+
+  /// columns x n_x: row j is state j (grid samples or Fourier coefficients).
+  Eigen::Map<tsi::Matrix> data() { return fft_.data(); }
+  /// Unnormalised: sum_j a_j e^{-2 pi i j k / n_x}.
+  void forward() { fft_.forward_unnormalised(); }
+  /// Unnormalised: sum_k a_k e^{+2 pi i j k / n_x}.
+  void backward() { fft_.backward(); }
+  /// Work space of the same shape (the grid values of the state in a derivative).
+  tsi::Matrix& scratch() { return scratch_; }
+
+ private:
+  tsi::FftBatch fft_;
+  tsi::Matrix scratch_;
+};
+
+/// cos and sin of a set of phases.
+struct Phases {
+  Phases() = default;
+  explicit Phases(const tsi::RealVector& taus) : cos(taus.array().cos()), sin(taus.array().sin()) {}
+  tsi::RealVector cos, sin;
+};
+
+class KleinGordon final : public tsi::Model {
+ public:
+  KleinGordon(double eps, int n_x, double lambda)
+      : Model(eps), n_x_(n_x), lambda_(lambda), inverse_a_(n_x), remainder_(n_x) {
+    for (int j = 0; j < n_x; ++j) {
+      const double k = 2 * j <= n_x ? j : j - n_x;  // the Nyquist index as k = n_x / 2
+      const double root = std::sqrt(1.0 + eps * k * k);
+      inverse_a_(j) = 1.0 / std::sqrt(root);
+      remainder_(j) = k * k / (1.0 + root);
+    }
+    batch(1);  // the single-state plans (filtered, direct, invariants)
+  }
+  using Model::linear_flow;
+  using Model::nonlinear_field;
+
+  Index dim() const override { return n_x_; }
+  bool is_complex() const override { return true; }
+
+  // e^{JM tau} = e^{i tau}: one phase for every coordinate.
+  void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
+    for (Index j = 0; j < u.cols(); ++j) u.col(j) *= std::polar(1.0, taus(j));
+  }
+
+  // i lambda sqrt(2 pi) / n_x a^{-1} forward(z^3), z = Re backward(a^{-1} c) / sqrt(2 pi).
+  void nonlinear_field(ConstMatrixRef c, MatrixRef out) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    fused_field<false>(Phases{}, batch(c.cols()), c, out);
+  }
+
+  void filtered_field(const tsi::RealVector& taus, MatrixRef c, MatrixRef out) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    fused_field<true>(Phases(taus), batch(c.cols()), c, out);
+  }
+
+  // A run's tau grid: cos and sin of its phases, and transforms of its own (no lock: one run's
+  // work space).
+  class GridField final : public tsi::TauGridField {
+   public:
+    GridField(const KleinGordon& model, const tsi::RealVector& taus)
+        : model_(model), phases_(taus), batch_(model.n_x_, taus.size()) {}
+    void evaluate(MatrixRef c, MatrixRef out) override { model_.fused_field<true>(phases_, batch_, c, out); }
+
+   private:
+    const KleinGordon& model_;
+    Phases phases_;
+    XBatch batch_;
+  };
+
+  std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
+    return std::make_unique<GridField>(*this, taus);
+  }
+
+  // f_tau(c) = e^{-i tau} N(e^{i tau} c) in one pass each way. Since e^{JM tau} is the scalar
+  // e^{i tau}, backward(a^{-1} e^{i tau} c) = e^{i tau} g with g = backward(a^{-1} c): the phase
+  // enters only the real part taken on the grid, z = cos tau Re g - sin tau Im g (up to
+  // sqrt(2 pi)), and leaves as e^{-i tau} on the way out. Without Rotate, tau = 0 (the field
+  // N itself; `phases` is not read). `c` is not written.
+  template <bool Rotate>
+  void fused_field(const Phases& phases, XBatch& b, ConstMatrixRef c, MatrixRef out) const {
+    auto w = b.data();  // row j: state j
+    const Index cols = c.cols();
+    for (Index k = 0; k < n_x_; ++k)
+      for (Index j = 0; j < cols; ++j) w(j, k) = inverse_a_(k) * c(k, j);
+    b.backward();
+    // backward(a^{-1} c) = sqrt(2 pi) g; z^3 is Re(.)^3 / (2 pi)^{3/2}, and the field's factor
+    // sqrt(2 pi) / n_x: lambda Re(.)^3 / (2 pi n_x), real, before the forward transform.
+    const double scale = lambda_ / (tsi::two_pi * n_x_);
+    for (Index k = 0; k < n_x_; ++k)
+      for (Index j = 0; j < cols; ++j) {
+        const double re =
+            Rotate ? phases.cos(j) * w(j, k).real() - phases.sin(j) * w(j, k).imag() : w(j, k).real();
+        w(j, k) = scale * re * re * re;
+      }
+    b.forward();
+    // out = i e^{-i tau} a^{-1} F: i e^{-i tau} = sin tau + i cos tau.
+    for (Index j = 0; j < cols; ++j) {
+      const Complex turn = Rotate ? Complex(phases.sin(j), phases.cos(j)) : Complex(0.0, 1.0);
+      for (Index k = 0; k < n_x_; ++k) out(k, j) = inverse_a_(k) * times(w(j, k), turn);
+    }
+  }
+
+  // D(J grad H1)(c) d = i lambda sqrt(2 pi) / n_x a^{-1} forward(3 z^2 dz), dz the real part of
+  // backward(a^{-1} d) / sqrt(2 pi): same scaling as the field.
+  void nonlinear_field_derivative(ConstMatrixRef c, ConstMatrixRef d, MatrixRef out) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const Index cols = c.cols();
+    XBatch& b = batch(cols);
+    tsi::Matrix& grid = b.scratch();
+    auto w = b.data();
+    for (Index k = 0; k < n_x_; ++k)
+      for (Index j = 0; j < cols; ++j) w(j, k) = inverse_a_(k) * c(k, j);
+    b.backward();
+    grid = w;
+    for (Index k = 0; k < n_x_; ++k)
+      for (Index j = 0; j < cols; ++j) w(j, k) = inverse_a_(k) * d(k, j);
+    b.backward();
+    const double scale = 3.0 * lambda_ / (tsi::two_pi * n_x_);
+    for (Index k = 0; k < n_x_; ++k)
+      for (Index j = 0; j < cols; ++j) {
+        const double z = grid(j, k).real();
+        w(j, k) = scale * z * z * w(j, k).real();
+      }
+    b.forward();
+    for (Index j = 0; j < cols; ++j)
+      for (Index k = 0; k < n_x_; ++k) out(k, j) = inverse_a_(k) * Complex(0.0, 1.0) * w(j, k);
+  }
+
+  void apply_M(const Vector& u, Vector& out) const override { out = u; }
+  void apply_J(const Vector& u, Vector& out) const override { out = Complex(0.0, 1.0) * u; }
+
+  // (lambda / 4) (2 pi / n_x) sum z_j^4 with z_j = Re backward(a^{-1} c)_j / sqrt(2 pi).
+  double H1(const Vector& c) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    XBatch& b = batch(1);
+    auto w = b.data();
+    w.row(0) = inverse_a_.cwiseProduct(c).transpose();
+    b.backward();
+    return lambda_ * w.row(0).real().array().pow(4).sum() / (4.0 * tsi::two_pi * n_x_);
+  }
+
+  const tsi::RealVector& linear_remainder() const override { return remainder_; }
+
+  bool has_exact_nonlinear_flow() const override { return true; }
+
+  // z is constant along u' = J grad H1 (the field only moves p), so the field is too.
+  void nonlinear_flow(double t, Vector& c) const override {
+    const Vector field = nonlinear_field(c);
+    c += t * field;
+  }
+
+  // v0(x) = cos x / (1 + sin^2 x) - (i/2) sin x / (1 + cos^2 x) (see the header).
+  Vector initial_value() const override {
+    Vector v(n_x_);
+    for (Index j = 0; j < n_x_; ++j) {
+      const double x = tsi::two_pi * static_cast<double>(j) / n_x_, s = std::sin(x), co = std::cos(x);
+      v(j) = Complex(co / (1.0 + s * s), -0.5 * s / (1.0 + co * co));
+    }
+    return from_physical(v);
+  }
+
+  // Grid samples of v -> c = sqrt(2 pi) / n_x * a forward(v).
+  Vector from_physical(const Vector& v) const override {
+    if (v.size() != n_x_)
+      throw tsi::ConfigError(
+          "model.u0", "got " + std::to_string(v.size()) + " samples, expected n_x = " + std::to_string(n_x_));
+    std::lock_guard<std::mutex> lock(mutex_);
+    XBatch& b = batch(1);
+    auto w = b.data();
+    w.row(0) = v.transpose();
+    b.forward();
+    return (std::sqrt(tsi::two_pi) / n_x_) * w.row(0).transpose().cwiseQuotient(inverse_a_.cast<Complex>());
+  }
+
+  // c -> v = backward(a^{-1} c) / sqrt(2 pi).
+  Vector to_physical(const Vector& c) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    XBatch& b = batch(1);
+    auto w = b.data();
+    w.row(0) = inverse_a_.cwiseProduct(c).transpose();
+    b.backward();
+    return w.row(0).transpose() / std::sqrt(tsi::two_pi);
+  }
+
+  // Discrete L2 norm of grid samples.
+  double error_norm(const Vector& v) const override { return std::sqrt(tsi::two_pi / n_x_) * v.norm(); }
+
+ private:
+  // The transforms for batches of `columns` states, planned on first use and kept. Callers
+  // hold mutex_.
+  XBatch& batch(Index columns) const {
+    auto it = batches_.find(columns);
+    if (it == batches_.end()) it = batches_.emplace(columns, std::make_unique<XBatch>(n_x_, columns)).first;
+    return *it->second;
+  }
+
+  // a b, written out: std::complex's operator* tests every product for inf/NaN.
+  static Complex times(Complex a, Complex b) {
+    return {a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real()};
+  }
+
+  int n_x_;
+  double lambda_;
+  tsi::RealVector inverse_a_;  // a_k^{-1} = (1 + eps k^2)^{-1/4}
+  tsi::RealVector remainder_;  // A_k = k^2 / (1 + sqrt(1 + eps k^2))
+  mutable std::mutex mutex_;   // the batches' buffers are shared work space
+  mutable std::map<Index, std::unique_ptr<XBatch>> batches_;
+};
+
+void register_klein_gordon(tsi::Registry& registry) {
+  tsi::ModelEntry entry;
+  entry.info.name = "klein-gordon";
+  entry.info.aliases = {"kg"};
+  entry.info.summary =
+      "nonlinear Klein-Gordon e^2 z_tt - z_xx + z/e^2 + lambda z^3 = 0 on the torus, eps = e^2, Fourier in x, "
+      "dim n_x";
+  entry.info.params = {
+      tsi::integer_param("n_x", 16, "Fourier modes (grid points) in x; u0 is given as samples of v on this grid")
+          .check(
+              [](const tsi::Json& v) {
+                return v.get<long>() >= 2 && v.get<long>() <= (1L << 20) && v.get<long>() % 2 == 0;
+              },
+              "an even integer in [2, 1048576]"),
+      tsi::number_param("lambda", 1.0, "coefficient of the cubic term lambda z^3")
+          .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number")};
+  entry.default_n_tau = 32;
+  entry.nonlinearity_degree = 3;
+  // From h = 1/16: coarser steps are pre-asymptotic for the modes 3, 5, 7 of the default u0
+  // (h A_k >~ 1). eps = 1e-2 is left out (h = 1/16 and 1/32 lie within 1% of whole numbers of
+  // half fast periods, a step-size resonance), and so is 1/16, where FD is pre-asymptotic down
+  // to h = 1/128 (order 0.90 over 1/16 .. 1/128, 1.74 over 1/64 .. 1/512).
+  entry.verification = {{1.0, 1.0 / 256, 1e-4, 1e-6}, {16, 32, 64, 128}};
+  entry.create = [](const tsi::Params& p) {
+    return std::make_unique<KleinGordon>(p.number("eps"), static_cast<int>(p.integer("n_x")), p.number("lambda"));
+  };
+  registry.add_model(std::move(entry));
+}
+
+}  // namespace
+
+TSI_PLUGIN("klein-gordon", register_klein_gordon)
