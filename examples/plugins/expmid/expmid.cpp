@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 
+#include "tsi/algebra.hpp"
 #include "tsi/phi.hpp"
 #include "tsi/plugin.hpp"
 
@@ -21,9 +22,9 @@ class ExpMidpoint final : public tsi::Stepper {
   void step(tsi::Problem& problem, double t, double h, Vector& y) override {
     if (h != h_ || problem.size() != e_full_.size()) prepare(problem, h);
     problem.nonlinear(t, y, n_);
-    stage_ = e_half_.cwiseProduct(y) + b_half_.cwiseProduct(n_);
+    tsi::algebra::diagonal_combination(e_half_, y, b_half_, n_, stage_);
     problem.nonlinear(t + 0.5 * h, stage_, n_);
-    y = e_full_.cwiseProduct(y) + b_full_.cwiseProduct(n_);
+    tsi::algebra::diagonal_combination(e_full_, y, b_full_, n_, y);
   }
 
  private:
