@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <fstream>
 #include <map>
 #include <set>
@@ -176,19 +177,34 @@ Json study_rows(const Study& study, const std::vector<RunOutcome>& outcomes) {
 }
 
 Json convergence_summary(const Json& rows) {
+  // Every run of a series, failed ones included: an order is never fitted across a run that
+  // has no error (blow-up, failure) nor over one whose error is 0.
   std::map<std::string, std::vector<const Json*>> series;
-  for (const auto& row : rows)
-    if (row["error"].is_number() && row["error"].get<double>() > 0) series[series_key(row, false)].push_back(&row);
+  for (const auto& row : rows) series[series_key(row, false)].push_back(&row);
   Json out = {{"series", Json::array()}, {"uniform", Json::array()}};
   for (auto& [key, members] : series) {
     std::sort(members.begin(), members.end(), [](const Json* a, const Json* b) { return (*a)["h"] > (*b)["h"]; });
     std::vector<double> h, e;
-    for (const Json* m : members) h.push_back((*m)["h"]), e.push_back((*m)["error"]);
+    Json errors = Json::array();
+    size_t failed = 0;
+    for (const Json* m : members) {
+      const bool has_error = (*m)["error"].is_number();
+      h.push_back((*m)["h"]);
+      e.push_back(has_error ? (*m)["error"].get<double>() : std::numeric_limits<double>::quiet_NaN());
+      errors.push_back(has_error ? (*m)["error"] : Json());
+      failed += has_error ? 0 : 1;
+    }
     Json s = {{"label", (*members[0])["label"]}, {"scheme", (*members[0])["scheme"]},
               {"model", (*members[0])["model"]}, {"eps", (*members[0])["eps"]},
-              {"varied", (*members[0])["varied"]}, {"h", h}, {"error", e}};
-    s["successive_orders"] = h.size() >= 2 ? Json(successive_orders(h, e)) : Json::array();
-    s["least_squares_order"] = h.size() >= 2 ? Json(least_squares_order(h, e)) : Json();
+              {"varied", (*members[0])["varied"]}, {"h", h}, {"error", errors}};
+    Json successive = Json::array();
+    for (size_t k = 0; k + 1 < e.size(); ++k)
+      successive.push_back(e[k] > 0 && e[k + 1] > 0 ? Json(std::log(e[k] / e[k + 1]) / std::log(h[k] / h[k + 1]))
+                                                    : Json());
+    s["successive_orders"] = successive;
+    const OrderFit fit = fit_order(h, e, 0.0, 2);
+    s["least_squares_order"] = fit.finite && fit.measurable && fit.used == e.size() ? Json(fit.order) : Json();
+    if (failed) s["failed_runs"] = failed;
     out["series"].push_back(s);
   }
   // Uniform error: at each h, the largest error over eps, per series without eps.
@@ -346,9 +362,12 @@ std::string study_text(const Study& study, const Json& rows) {
         std::string c = "-";
         for (const auto& series : summary["series"])
           if (series["eps"] == e && series["scheme"] == first["scheme"] && series["label"] == first["label"] &&
-              series["varied"] == first["varied"] && series["model"] == first["model"] &&
-              series["least_squares_order"].is_number())
-            c = fmt::format("{:.2f}", series["least_squares_order"].get<double>());
+              series["varied"] == first["varied"] && series["model"] == first["model"]) {
+            if (series["least_squares_order"].is_number())
+              c = fmt::format("{:.2f}", series["least_squares_order"].get<double>());
+            else if (series.contains("failed_runs"))  // never fitted across a failure
+              c = fmt::format("{} failed", series["failed_runs"].get<size_t>());
+          }
         s += fmt::format("{:>21}", c);
       }
       s += "\n";

@@ -49,6 +49,23 @@ TEST_CASE("the convergence summary groups series by eps and takes the max over e
   CHECK(summary["uniform"][0]["max_error_over_eps"][0].get<double>() == doctest::Approx(0.5));  // 2 * 0.5^2
 }
 
+TEST_CASE("the convergence summary never fits an order across a failed run") {
+  tsi::Json rows = tsi::Json::array();
+  int k = 0;
+  for (double h : {0.5, 0.25, 0.125, 0.0625}) rows.push_back(row(fmt::format("r{}", ++k), 1.0, h, h * h));
+  rows[1]["error"] = nullptr;  // h = 1/4 blew up
+  rows[1]["status"] = "blow-up";
+  const tsi::Json summary = tsi::app::convergence_summary(rows);
+  REQUIRE(summary["series"].size() == 1);
+  const tsi::Json& s = summary["series"][0];
+  CHECK(s["h"].size() == 4);  // the failed run stays in the series
+  CHECK(s["error"][1].is_null());
+  CHECK(s["least_squares_order"].is_null());  // 2.0 over the survivors would hide the blow-up
+  CHECK(s["failed_runs"] == 1);
+  CHECK(s["successive_orders"][0].is_null());
+  CHECK(s["successive_orders"][2].get<double>() == doctest::Approx(2.0));
+}
+
 TEST_CASE("drift slope is the least-squares slope over the chosen window") {
   std::string csv = "t,H,I,m,err_H,err_I,err_m,tau_roughness\n";
   for (int i = 0; i <= 100; ++i) {
