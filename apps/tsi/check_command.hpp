@@ -2,20 +2,18 @@
 #include <string>
 #include <vector>
 
+#include "tsi/model_checks.hpp"
 #include "tsi/params.hpp"
 #include "tsi/plugin_loader.hpp"
 #include "tsi/registry.hpp"
 
 namespace tsi::app {
 
-/// What `tsi check` checks.
-struct CheckOptions {
+/// What `tsi check` checks: the models and schemes to select, and how (ModelCheckOptions).
+struct CheckOptions : ModelCheckOptions {
   std::string model;                 ///< one model (name or alias); empty: see check_command
   std::vector<std::string> plugins;  ///< plugin files (loaded if needed) whose entries are checked
   std::vector<std::string> schemes;  ///< restrict to these two-scale schemes (empty: see check_command)
-  std::vector<double> epsilons;      ///< the eps values of the order checks (empty: the model's regime)
-  std::vector<long> steps;           ///< numbers of steps over T = 1 of the order fits (empty: the model's regime)
-  Json model_params = Json::object();  ///< model parameters besides eps (--set model.KEY=VALUE)
 };
 
 /// `tsi check [MODEL] [--plugin FILE] [--scheme NAME] [--eps EPS] [--steps N] [--set model.KEY=VALUE]`:

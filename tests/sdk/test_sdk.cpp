@@ -88,7 +88,7 @@ TEST_CASE("sdk: an out-of-tree model plugin builds against an installed tsi and 
         "lib/tsi/plugins/tsi_rk78.so", "include/tsi/model.hpp", "include/tsi/plugin.hpp",
         "lib/cmake/tsi/tsiConfig.cmake", "lib/cmake/tsi/tsiConfigVersion.cmake",
         "lib/cmake/tsi/tsiTargets.cmake", "lib/cmake/tsi/TsiPlugin.cmake", "include/tsi/assembly.hpp",
-        "include/tsi/algebra.hpp", "share/doc/tsi/SPEC.md", "share/doc/tsi/writing-a-model.md"}) {
+        "include/tsi/algebra.hpp", "include/tsi/model_checks.hpp", "share/doc/tsi/SPEC.md", "share/doc/tsi/writing-a-model.md"}) {
     CHECK_MESSAGE(fs::exists(prefix / file), "not installed: " << file);
   }
   CHECK_FALSE(fs::exists(prefix / "lib/tsi/plugins/tsi_fixture_good.so"));  // test fixtures stay out
