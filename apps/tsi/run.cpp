@@ -178,6 +178,8 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   result["rhs_evaluations"] = reformulation->evaluations();
   result["tau_roughness_max"] = recorder.roughness_max();
   result["tau_spread_max"] = recorder.spread_max();
+  const std::vector<double> reprepared = reformulation->repreparation_times();
+  result["repreparations"] = {{"count", reprepared.size()}, {"times", reprepared}};
   result["wall_seconds"] = wall;
 
   if (outcome.ok && config.contains("reference")) {

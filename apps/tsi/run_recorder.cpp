@@ -27,7 +27,7 @@ void check_invariant_name(const std::string& name, const std::string& column, co
     throw Error(fmt::format("the model declares an invariant named \"{}\": expected letters, digits and '_'", name));
   if (taken.count(name) || taken.count(column))
     throw Error(fmt::format("the model declares an invariant named \"{}\": its columns {} and {} must not be "
-                            "taken already (t, H, I, m, err_H, err_I, err_m, tau_roughness, or another invariant's)",
+                            "taken already (t, H, I, m, err_H, err_I, err_m, tau_roughness, tau_spread, or another invariant's)",
                             name, name, column));
 }
 }  // namespace
@@ -42,10 +42,10 @@ RunRecorder::RunRecorder(const Model& model, Reformulation& reformulation, const
       roughness_warn_(config["monitor"]["tau_roughness_warn"]),
       spread_growth_warn_(config["monitor"]["tau_spread_growth_warn"]),
       u_(u0),
-      csv_("t,H,I,m,err_H,err_I,err_m,tau_roughness\n") {
+      csv_("t,H,I,m,err_H,err_I,err_m,tau_roughness,tau_spread\n") {
   const double initial[3] = {model.energy(u0), model.oscillatory_energy(u0), model.mass(u0)};
   for (int k = 0; k < 3; ++k) tracks_[k].initial = tracks_[k].final = initial[k];
-  std::set<std::string> taken = {"t", "H", "I", "m", "err_H", "err_I", "err_m", "tau_roughness"};
+  std::set<std::string> taken = {"t", "H", "I", "m", "err_H", "err_I", "err_m", "tau_roughness", "tau_spread"};
   for (auto& invariant : model.invariants()) {
     if (!invariant.value)
       throw Error(fmt::format("the model declares an invariant \"{}\" without a value function", invariant.name));
@@ -115,8 +115,8 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
   }
   const bool blow_up = errors[0] > max_err_H_;
   if (n % every_ == 0 || n == n_steps_ || blow_up) {
-    csv_ += fmt::format("{:.17g},{:.17g},{:.17g},{:.17g},{:.6e},{:.6e},{:.6e},{:.6e}", t, values[0], values[1],
-                        values[2], errors[0], errors[1], errors[2], roughness);
+    csv_ += fmt::format("{:.17g},{:.17g},{:.17g},{:.17g},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}", t, values[0],
+                        values[1], values[2], errors[0], errors[1], errors[2], roughness, spread);
     for (const auto& d : declared_) csv_ += fmt::format(",{:.17g},{:.6e}", d.final, d.change);
     csv_ += "\n";
   }

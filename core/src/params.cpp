@@ -41,6 +41,8 @@ bool has_type(ParamType type, const Json& v) {
       return v.is_string();
     case ParamType::Array:
       return v.is_array();
+    case ParamType::IntegerOrString:
+      return v.is_string() || v.is_number_integer() || integral_float(v);
   }
   return false;
 }
@@ -68,6 +70,8 @@ std::string describe(ParamType type) {
       return "a string";
     case ParamType::Array:
       return "an array";
+    case ParamType::IntegerOrString:
+      return "an integer or a string";
   }
   return "a value";
 }
@@ -127,6 +131,10 @@ ParamSpec string_param(std::string name, Json default_value, std::string descrip
 
 ParamSpec array_param(std::string name, std::string description) {
   return make_spec(std::move(name), ParamType::Array, Json(), std::move(description));
+}
+
+ParamSpec integer_or_string_param(std::string name, Json default_value, std::string description) {
+  return make_spec(std::move(name), ParamType::IntegerOrString, std::move(default_value), std::move(description));
 }
 
 Json resolve_params(const ParamSchema& schema, const Json& given, const std::string& path) {

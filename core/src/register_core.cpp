@@ -28,7 +28,22 @@ void register_core(Registry& registry) {
                      "order of the prepared initial data (1, 2 or 3); default: what the scheme "
                      "needs for uniform second order")
            .check([](const Json& v) { return v.get<long>() >= 1 && v.get<long>() <= 3; },
-                  "1, 2 or 3")},
+                  "1, 2 or 3"),
+       integer_or_string_param("reprepare", "never",
+                               "re-prepare U from the solution (SPEC.md section 6): never (the paper's "
+                               "schemes), every K steps (an integer), or auto (when tau_spread grows)")
+           .check(
+               [](const Json& v) {
+                 if (v.is_string()) return v == "never" || v == "auto";
+                 return v.get<double>() >= 1 && v.get<double>() <= 1e12;
+               },
+               "\"never\", \"auto\" or a number of steps from 1"),
+       number_param("reprepare_growth", 100.0,
+                    "auto: re-prepare when tau_spread exceeds this many times its value one step after "
+                    "the last preparation (and 1e-6)")
+           .range(1.0, 1e300, true, false),
+       integer_param("reprepare_min_gap", 10, "auto: at most one re-preparation in this many steps")
+           .check([](const Json& v) { return v.get<long>() >= 1; }, "a positive integer")},
       ""};
   two_scale.complete = [](Json& p, const Selection& s) {
     if (p["n_tau"].is_null()) p["n_tau"] = s.model.default_n_tau;
@@ -37,7 +52,18 @@ void register_core(Registry& registry) {
   two_scale.create = [](std::shared_ptr<const Model> model, const Params& p) {
     const int n_tau = p.has("n_tau") ? static_cast<int>(p.integer("n_tau")) : 64;
     const int order = p.has("initial_data_order") ? static_cast<int>(p.integer("initial_data_order")) : 2;
-    return std::make_unique<TwoScale>(std::move(model), n_tau, order);
+    Repreparation repreparation;
+    if (p.has("reprepare")) {
+      const Json& rule = p.raw().at("reprepare");
+      if (rule == "auto") repreparation.mode = Repreparation::Mode::Auto;
+      if (rule.is_number()) {
+        repreparation.mode = Repreparation::Mode::Every;
+        repreparation.every = static_cast<long>(rule.get<double>());
+      }
+    }
+    if (p.has("reprepare_growth")) repreparation.growth = p.number("reprepare_growth");
+    if (p.has("reprepare_min_gap")) repreparation.min_gap = p.integer("reprepare_min_gap");
+    return std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation);
   };
   registry.add_reformulation(std::move(two_scale));
 

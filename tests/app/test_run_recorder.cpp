@@ -68,7 +68,7 @@ TEST_CASE("recorder: a declared invariant gets a value and a change column, rela
     REQUIRE(recorder.observe(n, t, exact(t)));
   }
   const std::string csv = recorder.csv();
-  CHECK(csv.substr(0, csv.find('\n')) == "t,H,I,m,err_H,err_I,err_m,tau_roughness,Q,err_Q,z,abs_err_z");
+  CHECK(csv.substr(0, csv.find('\n')) == "t,H,I,m,err_H,err_I,err_m,tau_roughness,tau_spread,Q,err_Q,z,abs_err_z");
 
   const Json inv = recorder.invariants_json();
   CHECK(inv["Q"]["change"] == "relative");
@@ -92,12 +92,12 @@ TEST_CASE("recorder: a declared invariant gets a value and a change column, rela
     fields.push_back(std::stod(last.substr(pos, comma - pos)));
     pos = comma == std::string::npos ? last.size() : comma + 1;
   }
-  REQUIRE(fields.size() == 12);
+  REQUIRE(fields.size() == 13);
   CHECK(fields[0] == 1.0);
-  CHECK(fields[8] == doctest::Approx(std::pow(std::cos(1.0), 2) + 1.0).epsilon(1e-15));
-  CHECK(fields[9] == doctest::Approx(std::pow(std::sin(1.0), 2) / 2.0).epsilon(1e-6));
-  CHECK(fields[10] == doctest::Approx(-std::sin(1.0)).epsilon(1e-15));
-  CHECK(fields[11] == doctest::Approx(std::sin(1.0)).epsilon(1e-6));
+  CHECK(fields[9] == doctest::Approx(std::pow(std::cos(1.0), 2) + 1.0).epsilon(1e-15));
+  CHECK(fields[10] == doctest::Approx(std::pow(std::sin(1.0), 2) / 2.0).epsilon(1e-6));
+  CHECK(fields[11] == doctest::Approx(-std::sin(1.0)).epsilon(1e-15));
+  CHECK(fields[12] == doctest::Approx(std::sin(1.0)).epsilon(1e-6));
 }
 
 TEST_CASE("recorder: an initial value at the threshold is changed absolutely, above it relatively") {

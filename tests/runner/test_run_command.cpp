@@ -117,11 +117,11 @@ TEST_CASE("run: the example config with --set time.h=0.25 writes a complete resu
   SUBCASE("invariants.csv: header, one row per step, zero errors at t = 0") {
     const std::vector<std::string> lines = lines_of(read_text(fs::path(out) / "invariants.csv"));
     REQUIRE(lines.size() == 1 + 4 + 1);
-    CHECK(lines[0] == "t,H,I,m,err_H,err_I,err_m,tau_roughness");
+    CHECK(lines[0] == "t,H,I,m,err_H,err_I,err_m,tau_roughness,tau_spread");
     for (std::size_t i = 1; i < lines.size(); ++i) {
       INFO("row " << i << ": " << lines[i]);
       const auto fields = csv_fields(lines[i]);
-      REQUIRE(fields.size() == 8);
+      REQUIRE(fields.size() == 9);
       CHECK(std::stod(fields[0]) == doctest::Approx(0.25 * static_cast<double>(i - 1)));
       for (const auto& f : fields) CHECK(std::isfinite(std::stod(f)));
     }
@@ -328,7 +328,7 @@ TEST_CASE("run: a non-finite solution stops the run at once, keeping everything 
   CHECK(steps < 400);
   for (const auto& x : result.at("u_final")) CHECK(std::isfinite(x.get<double>()));
   const auto lines = lines_of(read_text(fs::path(out) / "invariants.csv"));
-  CHECK(lines.at(0) == "t,H,I,m,err_H,err_I,err_m,tau_roughness");
+  CHECK(lines.at(0) == "t,H,I,m,err_H,err_I,err_m,tau_roughness,tau_spread");
   CHECK(static_cast<long>(lines.size()) == steps + 2);  // header and t_0 .. t_steps
 }
 
@@ -426,15 +426,15 @@ TEST_CASE("run: nls records its momentum P in invariants.csv and result.json, re
 
   const auto lines = lines_of(read_text(fs::path(out) / "invariants.csv"));
   REQUIRE(lines.size() == 1 + 5);
-  CHECK(lines[0] == "t,H,I,m,err_H,err_I,err_m,tau_roughness,P,err_P");
+  CHECK(lines[0] == "t,H,I,m,err_H,err_I,err_m,tau_roughness,tau_spread,P,err_P");
   double largest = 0.0;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     INFO("row " << i << ": " << lines[i]);
     const auto fields = csv_fields(lines[i]);
-    REQUIRE(fields.size() == 10);
-    largest = std::max(largest, std::stod(fields[9]));
+    REQUIRE(fields.size() == 11);
+    largest = std::max(largest, std::stod(fields[10]));
   }
-  CHECK(std::stod(csv_fields(lines[1])[9]) < 1e-14);
+  CHECK(std::stod(csv_fields(lines[1])[10]) < 1e-14);
 
   const Json result = read_json(fs::path(out) / "result.json");
   const Json& P = result.at("invariants").at("P");
@@ -442,8 +442,8 @@ TEST_CASE("run: nls records its momentum P in invariants.csv and result.json, re
   CHECK(P.at("change") == "relative");
   CHECK(P.at("column") == "err_P");
   CHECK(contains(P.at("description").get<std::string>(), "momentum"));
-  CHECK(P.at("initial").get<double>() == doctest::Approx(std::stod(csv_fields(lines[1])[8])).epsilon(1e-15));
-  CHECK(P.at("final").get<double>() == doctest::Approx(std::stod(csv_fields(lines.back())[8])).epsilon(1e-15));
+  CHECK(P.at("initial").get<double>() == doctest::Approx(std::stod(csv_fields(lines[1])[9])).epsilon(1e-15));
+  CHECK(P.at("final").get<double>() == doctest::Approx(std::stod(csv_fields(lines.back())[9])).epsilon(1e-15));
   CHECK(P.at("max_change").get<double>() == doctest::Approx(largest).epsilon(1e-6));
   CHECK(P.at("max_change").get<double>() > 0.0);
   // The paper's u0 = e^{ix} / (1 + sin^2 x) carries momentum close to its mass.
@@ -460,7 +460,7 @@ TEST_CASE("run: nls records its momentum P in invariants.csv and result.json, re
   REQUIRE(real.exit_code == 0);
   CHECK(contains(real.out, "max abs. change of P"));
   CHECK(lines_of(read_text(fs::path(out) / "invariants.csv"))[0] ==
-        "t,H,I,m,err_H,err_I,err_m,tau_roughness,P,abs_err_P");
+        "t,H,I,m,err_H,err_I,err_m,tau_roughness,tau_spread,P,abs_err_P");
   const Json zero = read_json(fs::path(out) / "result.json").at("invariants").at("P");
   CHECK(zero.at("change") == "absolute");
   CHECK(zero.at("column") == "abs_err_P");

@@ -10,7 +10,7 @@ namespace tsi {
 
 using Json = nlohmann::json;
 
-enum class ParamType { Number, Integer, Boolean, String, Array };
+enum class ParamType { Number, Integer, Boolean, String, Array, IntegerOrString };
 
 /// Name of a parameter type as users read it ("a number", "an integer", ...).
 TSI_API std::string describe(ParamType type);
@@ -40,6 +40,8 @@ TSI_API ParamSpec integer_param(std::string name, Json default_value, std::strin
 TSI_API ParamSpec bool_param(std::string name, Json default_value, std::string description);
 TSI_API ParamSpec string_param(std::string name, Json default_value, std::string description);
 TSI_API ParamSpec array_param(std::string name, std::string description);
+/// A parameter that is a keyword or a count ("never", "auto" or every K steps).
+TSI_API ParamSpec integer_or_string_param(std::string name, Json default_value, std::string description);
 
 /// Checks `given` (a JSON object) against `schema`: rejects unknown keys (listing the valid
 /// ones), wrong types and out-of-range values with a ConfigError naming `path.key`, and

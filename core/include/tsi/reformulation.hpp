@@ -1,5 +1,6 @@
 #pragma once
 #include <memory>
+#include <vector>
 
 #include "tsi/export.hpp"
 #include "tsi/model.hpp"
@@ -23,6 +24,8 @@ class TSI_API Reformulation : public Problem {
   /// tau). Each characteristic tau - t/eps = const of U is a trajectory of the model; this
   /// measures how far they have spread apart, which the run recorder watches for growth.
   virtual double tau_spread(const Vector& /*y*/) const { return 0.0; }
+  /// The times t_n at which the state was re-prepared (two-scale; empty otherwise).
+  virtual std::vector<double> repreparation_times() const { return {}; }
 
   const Model& model() const { return *model_; }
 

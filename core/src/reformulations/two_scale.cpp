@@ -8,7 +8,8 @@
 
 namespace tsi {
 
-TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order)
+TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order,
+                   Repreparation repreparation)
     : Reformulation(std::move(model)),
       dim_(model_->dim()),
       n_tau_(n_tau),
@@ -19,7 +20,8 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
       wave_numbers_(n_tau),
       multipliers_(dim_ * n_tau),
       fft_(n_tau, static_cast<int>(model_->dim())),
-      field_fft_(n_tau, static_cast<int>(model_->dim())) {
+      field_fft_(n_tau, static_cast<int>(model_->dim())),
+      repreparation_(repreparation) {
   if (n_tau <= 0 || n_tau % 2 != 0)
     throw ConfigError("reformulation.n_tau",
                       "got " + std::to_string(n_tau) + ", expected a positive even integer");
@@ -133,19 +135,55 @@ Vector TwoScale::evaluate(const Matrix& c, double tau) const {
 }
 
 Vector TwoScale::prepare(const Vector& u0) {
+  repreparation_times_.clear();
+  last_prepared_ = 0;
+  spread_baseline_ = -1.0;
+  return prepared_at(u0, 0.0);
+}
+
+Vector TwoScale::prepared_at(const Vector& v, double s) {
   Matrix c = Matrix::Zero(dim_, n_tau_);
   if (data_order_ >= 2) {
-    // eq. (2nd data); order 3 evaluates r1 at ubar = u0 - eps r1(u0)(0) and adds eps^2 r2(u0).
-    Matrix r = r1(u0);
+    // eq. (2nd data) centred at s; order 3 evaluates r1 at vbar = v - eps r1(v)(s) and adds
+    // eps^2 r2(v). s = 0 is the initial data.
+    Matrix r = r1(v);
     if (data_order_ == 3) {
-      const Vector ubar = u0 - eps_ * evaluate(r, 0.0);
-      r = r1(ubar) + eps_ * r2(u0);
+      const Vector vbar = v - eps_ * evaluate(r, s);
+      r = r1(vbar) + eps_ * r2(v);
     }
     c = eps_ * r;
-    c.col(0) -= evaluate(c, 0.0);  // U(0, 0) = u0 exactly: subtract the value at tau = 0
+    c.col(0) -= evaluate(c, s);  // U(s) = v exactly: subtract the value at tau = s
   }
-  c.col(0) += u0;
+  c.col(0) += v;
   return Eigen::Map<const Vector>(c.data(), size());
+}
+
+bool TwoScale::between_steps(long n, double t, Vector& y) {
+  switch (repreparation_.mode) {
+    case Repreparation::Mode::Never:
+      return false;
+    case Repreparation::Mode::Every:
+      if (n % repreparation_.every != 0) return false;
+      break;
+    case Repreparation::Mode::Auto: {
+      const double spread = tau_spread(y);
+      if (spread_baseline_ < 0.0) {  // one step after a preparation: the reference spread
+        spread_baseline_ = spread;
+        return false;
+      }
+      if (n - last_prepared_ < repreparation_.min_gap || !(spread > 1e-6) ||
+          !(spread > repreparation_.growth * spread_baseline_))
+        return false;
+      break;
+    }
+  }
+  const double s = fast_phase(t, eps_);
+  const Vector v = evaluate(Eigen::Map<const Matrix>(y.data(), dim_, n_tau_), s);
+  y = prepared_at(v, s);
+  repreparation_times_.push_back(t);
+  last_prepared_ = n;
+  spread_baseline_ = -1.0;
+  return true;
 }
 
 Vector TwoScale::read_back(const Vector& y, double t) {

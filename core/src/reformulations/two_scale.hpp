@@ -9,9 +9,18 @@ namespace tsi {
 /// stored as Fourier coefficients, d x N_tau column-major (column j = mode j), so that L is
 /// diagonal: -i k / eps + i omega_i for tau mode k and model coordinate i (omega: the model's
 /// remainder, zero without one). The Nyquist mode's -i k / eps is 0 (SPEC.md section 2).
+/// When a two-scale run re-prepares its data (SPEC.md section 6, "Re-preparation").
+struct Repreparation {
+  enum class Mode { Never, Every, Auto } mode = Mode::Never;
+  long every = 0;         ///< Every: each this many steps
+  double growth = 100.0;  ///< Auto: when tau_spread grew this many times over its value one step after the last preparation
+  long min_gap = 10;      ///< Auto: at most once in this many steps
+};
+
 class TwoScale final : public Reformulation {
  public:
-  TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order);
+  TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order,
+           Repreparation repreparation = {});
 
   Index size() const override { return dim_ * n_tau_; }
   const Vector& linear_multipliers() const override { return multipliers_; }
@@ -26,6 +35,10 @@ class TwoScale final : public Reformulation {
   Vector read_back(const Vector& y, double t) override;
   double tau_roughness(const Vector& y) const override;
   double tau_spread(const Vector& y) const override;
+  /// Re-prepares U when the rule says so: v_n = U(t_n, s_n), s_n = t_n/eps mod 2 pi, and U
+  /// rebuilt as prepared data centred at s_n (U(t_n, s_n) = v_n exactly, u(t_n) unchanged).
+  bool between_steps(long n, double t, Vector& y) override;
+  std::vector<double> repreparation_times() const override { return repreparation_times_; }
 
  private:
   /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau).
@@ -41,6 +54,9 @@ class TwoScale final : public Reformulation {
   /// r2(w) = A[Df(w) A f(w)] - A^2[Df(w) (Pi f(w) + JR w)] + JR A^2 f(w), as coefficients
   /// (SPEC.md's r2; the JR terms come from the remainder in the averaged flow).
   Matrix r2(const Vector& w);
+  /// Prepared data of the configured order centred at the phase s: U(s) = v exactly (s = 0:
+  /// the initial data).
+  Vector prepared_at(const Vector& v, double s);
   /// The trigonometric interpolant of coefficients c at tau (Nyquist split half/half).
   Vector evaluate(const Matrix& c, double tau) const;
 
@@ -56,6 +72,10 @@ class TwoScale final : public Reformulation {
   Vector remainder_grid_;  // remainder_ on every tau point (empty without a remainder)
   FftBatch fft_;        // U's coefficients -> its values on the tau grid
   FftBatch field_fft_;  // f_tau(U) on the grid -> its coefficients: the model writes here
+  Repreparation repreparation_;
+  std::vector<double> repreparation_times_;
+  long last_prepared_ = 0;        // the step of the last preparation
+  double spread_baseline_ = -1.0;  // tau_spread one step after it (-1: not yet measured)
 };
 
 }  // namespace tsi
