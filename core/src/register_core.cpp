@@ -38,11 +38,11 @@ void register_core(Registry& registry) {
                  return v.get<double>() >= 1 && v.get<double>() <= 1e12;
                },
                "\"never\", \"auto\" or a number of steps from 1"),
-       number_param("reprepare_growth", 100.0,
-                    "auto: re-prepare when tau_spread exceeds this many times its value one step after "
-                    "the last preparation (and 1e-6)")
-           .range(1.0, 1e300, true, false),
-       integer_param("reprepare_min_gap", 10, "auto: at most one re-preparation in this many steps")
+       number_param("reprepare_defect", 0.1,
+                    "auto: re-prepare when U is farther than this fraction of its prepared tau variation "
+                    "from the data prepared at its own diagonal value")
+           .range(0.0, 1e300, true, false),
+       integer_param("reprepare_min_gap", 10, "auto: test (one evaluation of r1) every this many steps")
            .check([](const Json& v) { return v.get<long>() >= 1; }, "a positive integer")},
       ""};
   two_scale.complete = [](Json& p, const Selection& s) {
@@ -61,7 +61,7 @@ void register_core(Registry& registry) {
         repreparation.every = static_cast<long>(rule.get<double>());
       }
     }
-    if (p.has("reprepare_growth")) repreparation.growth = p.number("reprepare_growth");
+    if (p.has("reprepare_defect")) repreparation.defect = p.number("reprepare_defect");
     if (p.has("reprepare_min_gap")) repreparation.min_gap = p.integer("reprepare_min_gap");
     return std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation);
   };

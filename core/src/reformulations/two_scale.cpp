@@ -137,7 +137,6 @@ Vector TwoScale::evaluate(const Matrix& c, double tau) const {
 Vector TwoScale::prepare(const Vector& u0) {
   repreparation_times_.clear();
   last_prepared_ = 0;
-  spread_baseline_ = -1.0;
   return prepared_at(u0, 0.0);
 }
 
@@ -159,30 +158,22 @@ Vector TwoScale::prepared_at(const Vector& v, double s) {
 }
 
 bool TwoScale::between_steps(long n, double t, Vector& y) {
-  switch (repreparation_.mode) {
-    case Repreparation::Mode::Never:
-      return false;
-    case Repreparation::Mode::Every:
-      if (n % repreparation_.every != 0) return false;
-      break;
-    case Repreparation::Mode::Auto: {
-      const double spread = tau_spread(y);
-      if (spread_baseline_ < 0.0) {  // one step after a preparation: the reference spread
-        spread_baseline_ = spread;
-        return false;
-      }
-      if (n - last_prepared_ < repreparation_.min_gap || !(spread > 1e-6) ||
-          !(spread > repreparation_.growth * spread_baseline_))
-        return false;
-      break;
-    }
-  }
+  if (repreparation_.mode == Repreparation::Mode::Never) return false;
+  if (repreparation_.mode == Repreparation::Mode::Every && n % repreparation_.every != 0) return false;
+  if (repreparation_.mode == Repreparation::Mode::Auto && (n - last_prepared_) % repreparation_.min_gap != 0)
+    return false;
   const double s = fast_phase(t, eps_);
   const Vector v = evaluate(Eigen::Map<const Matrix>(y.data(), dim_, n_tau_), s);
-  y = prepared_at(v, s);
+  Vector prepared = prepared_at(v, s);
+  if (repreparation_.mode == Repreparation::Mode::Auto) {
+    // U is due when it has drifted off the prepared data through its own diagonal value by more
+    // than a fraction of that data's tau variation (column 0 of the coefficients is the mean).
+    const double variation = prepared.segment(dim_, size() - dim_).norm();
+    if (!((y - prepared).norm() > repreparation_.defect * variation)) return false;
+  }
+  y.swap(prepared);
   repreparation_times_.push_back(t);
   last_prepared_ = n;
-  spread_baseline_ = -1.0;
   return true;
 }
 

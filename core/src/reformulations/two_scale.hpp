@@ -13,8 +13,10 @@ namespace tsi {
 struct Repreparation {
   enum class Mode { Never, Every, Auto } mode = Mode::Never;
   long every = 0;         ///< Every: each this many steps
-  double growth = 100.0;  ///< Auto: when tau_spread grew this many times over its value one step after the last preparation
-  long min_gap = 10;      ///< Auto: at most once in this many steps
+  /// Auto: re-prepare when U's distance from the prepared data at its own diagonal value,
+  /// |U - P(v_n, s_n)|, exceeds this fraction of P's own tau variation |P - mean P|.
+  double defect = 0.1;
+  long min_gap = 10;  ///< Auto: tested (one evaluation of r1) every this many steps
 };
 
 class TwoScale final : public Reformulation {
@@ -74,8 +76,7 @@ class TwoScale final : public Reformulation {
   FftBatch field_fft_;  // f_tau(U) on the grid -> its coefficients: the model writes here
   Repreparation repreparation_;
   std::vector<double> repreparation_times_;
-  long last_prepared_ = 0;        // the step of the last preparation
-  double spread_baseline_ = -1.0;  // tau_spread one step after it (-1: not yet measured)
+  long last_prepared_ = 0;  // the step of the last preparation
 };
 
 }  // namespace tsi
