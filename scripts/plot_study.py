@@ -48,18 +48,30 @@ def panels(n, width=6.0, height=4.4):
 
 
 def plot_convergence(rows, title, out):
+    # Failed runs (blow-up, no error) are drawn as red crosses along the top of their panel:
+    # a plot never hides them.
+    failed = [r for r in rows if not number(r["error"])]
     rows = [r for r in rows if number(r["error"])]
-    names = list(dict.fromkeys(series_name(r) for r in rows))
+    names = list(dict.fromkeys(series_name(r) for r in rows + failed))
     fig, axes = panels(len(names))
     for ax, name in zip(axes, names):
         mine = [r for r in rows if series_name(r) == name]
+        lost = [r for r in failed if series_name(r) == name]
         for eps in sorted({number(r["eps"]) for r in mine}, reverse=True):
             pts = sorted((number(r["h"]), number(r["error"])) for r in mine if number(r["eps"]) == eps)
             ax.loglog(*zip(*pts), "o-", label=f"eps = {fraction(eps)}")
-        hs = sorted({number(r["h"]) for r in mine})
-        top = max(number(r["error"]) for r in mine if number(r["h"]) == hs[-1])
-        ax.loglog(hs, [1.5 * top * (h / hs[-1]) ** 2 for h in hs], "k--", label="slope 2")
-        ax.set(xlabel="time step h", ylabel="relative error at t_end", title=f"{name} ({mine[0]['model']})")
+        if mine:
+            hs = sorted({number(r["h"]) for r in mine})
+            top = max(number(r["error"]) for r in mine if number(r["h"]) == hs[-1])
+            ax.loglog(hs, [1.5 * top * (h / hs[-1]) ** 2 for h in hs], "k--", label="slope 2")
+        if lost:
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            y = ax.get_ylim()[1] if mine else 1.0
+            ax.plot([number(r["h"]) for r in lost], [y] * len(lost), "rx", markersize=9, clip_on=False,
+                    label=f"failed: {len(lost)} run(s) (" + ", ".join(sorted({r['status'] for r in lost})) + ")")
+        ax.set(xlabel="time step h", ylabel="relative error at t_end",
+               title=f"{name} ({(mine or lost)[0]['model']})")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle(title, fontsize=10)

@@ -211,10 +211,11 @@ Json convergence_summary(const Json& rows) {
   std::map<std::string, std::map<double, double>> uniform;
   std::map<std::string, const Json*> first;
   for (const auto& row : rows) {
-    if (!row["error"].is_number()) continue;
     const std::string key = series_key(row, true);
     double& worst = uniform[key][row["h"].get<double>()];
-    worst = std::max(worst, row["error"].get<double>());
+    // A failed run (no error) makes the maximum unknown: NaN (null in JSON), never the survivors'.
+    worst = row["error"].is_number() && !std::isnan(worst) ? std::max(worst, row["error"].get<double>())
+                                                           : std::numeric_limits<double>::quiet_NaN();
     first.emplace(key, &row);
   }
   for (const auto& [key, by_h] : uniform) {
@@ -223,7 +224,7 @@ Json convergence_summary(const Json& rows) {
               {"h", Json::array()}, {"max_error_over_eps", Json::array()}};
     for (auto it = by_h.rbegin(); it != by_h.rend(); ++it) {
       u["h"].push_back(it->first);
-      u["max_error_over_eps"].push_back(it->second);
+      u["max_error_over_eps"].push_back(std::isnan(it->second) ? Json() : Json(it->second));
     }
     out["uniform"].push_back(u);
   }
@@ -347,15 +348,18 @@ std::string study_text(const Study& study, const Json& rows) {
       for (double h : hs) {
         s += fmt::format("  {:>8}", fraction(h));
         double worst = 0;
+        int failed_here = 0;  // a run without an error makes the maximum unknown: never the survivors'
         for (double e : epss) {
           const auto it = at.find({e, h});
           const Json* r = it == at.end() ? nullptr : it->second;
           std::string c = r ? cell((*r)["error"]) : "";
           if (r && (*r)["order"].is_number()) c += fmt::format(" ({:.2f})", (*r)["order"].get<double>());
           if (r && (*r)["error"].is_number()) worst = std::max(worst, (*r)["error"].get<double>());
+          if (r && !(*r)["error"].is_number()) ++failed_here;
           s += fmt::format("{:>21}", c);
         }
-        s += fmt::format("{:>14.3e}\n", worst);
+        s += failed_here ? fmt::format("{:>14}\n", fmt::format("{} failed", failed_here))
+                         : fmt::format("{:>14.3e}\n", worst);
       }
       s += fmt::format("  {:>8}", "LS order");
       for (double e : epss) {

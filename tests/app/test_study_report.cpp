@@ -100,3 +100,18 @@ TEST_CASE("work to reach an error every run beats is the cheapest run's, marked 
   CHECK(w[0]["seconds"][0].get<double>() == 1e-3);
   CHECK(w[0]["how"][0] == "at_most");
 }
+
+TEST_CASE("the max over eps is unknown, not the survivors' maximum, when a run at that h failed") {
+  tsi::Json rows = tsi::Json::array();
+  int k = 0;
+  for (double eps : {1.0, 0.01})
+    for (double h : {0.5, 0.25}) rows.push_back(row(fmt::format("r{}", ++k), eps, h, h * h));
+  rows[2]["error"] = nullptr;  // eps = 0.01, h = 1/2 blew up
+  rows[2]["status"] = "blow-up";
+  const tsi::Json summary = tsi::app::convergence_summary(rows);
+  REQUIRE(summary["uniform"].size() == 1);
+  const tsi::Json& u = summary["uniform"][0];
+  CHECK(u["h"][0].get<double>() == 0.5);
+  CHECK(u["max_error_over_eps"][0].is_null());  // 0.25 from eps = 1 alone would hide the blow-up
+  CHECK(u["max_error_over_eps"][1].get<double>() == doctest::Approx(0.0625));
+}
