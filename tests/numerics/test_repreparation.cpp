@@ -106,3 +106,39 @@ TEST_CASE("re-preparation: NLS at eps = 0.1 keeps its mass over T = 200 where th
   CHECK(every < 1e-3);      // measured 1.8e-4
   CHECK(automatic < 1e-3);  // measured 1.9e-4
 }
+
+TEST_CASE("re-preparation: every model keeps its order at T = 1 in its declared regime, every step and auto") {
+  // Second order is kept everywhere. The error may grow by a bounded factor: each re-preparation
+  // restarts the scheme (ME then takes its start-up step every step: 1.85 times the plain error
+  // on NLS at eps = 1, the largest measured) and leaves the O(eps^p) defect of the prepared data.
+  for (const std::string model : {"nls", "cpd", "klein-gordon"}) {
+    const auto& regime = Harness::instance().registry().model(model).verification;
+    std::vector<double> hs;
+    for (long n : regime.steps) hs.push_back(1.0 / static_cast<double>(n));
+    for (const auto* scheme : tsi::test::two_scale_schemes())
+      for (const double eps : regime.epsilons)
+        for (const Json& rule : {Json(1), Json("auto")}) {
+          std::vector<double> plain, reprepared;
+          for (long n : regime.steps) {
+            plain.push_back(error_at_one(model, scheme->info.name, eps, n, "never"));
+            reprepared.push_back(error_at_one(model, scheme->info.name, eps, n, rule));
+          }
+          const tsi::OrderFit fit = tsi::fit_order(hs, reprepared, 1e-7);
+          double worst = 0.0;
+          for (size_t i = 0; i < hs.size(); ++i) worst = std::max(worst, reprepared[i] / plain[i]);
+          CAPTURE(model);
+          CAPTURE(scheme->info.name);
+          CAPTURE(eps);
+          CAPTURE(rule.dump());
+          CAPTURE(fit.order);
+          CAPTURE(worst);
+          CHECK(fit.finite);
+          // At least second order: `auto` decides per run, so at some h it re-prepares and at
+          // others not, and the errors need not lie on one power law (FD at eps = 1 on the charged
+          // particle and Klein-Gordon: fitted orders 2.5 and 2.6, errors 0.6 to 0.7 times the plain;
+          // the lowest measured: 1.81, Klein-Gordon SE1 at eps = 1).
+          if (fit.measurable) CHECK(fit.order >= 1.8);
+          CHECK(worst <= 2.0);
+        }
+  }
+}
