@@ -394,6 +394,11 @@ std::string study_text(const Study& study, const Json& rows) {
     for (const auto& row : rows) {
       std::string name = row["label"].get<std::string>().empty() ? row["scheme"].get<std::string>()
                                                                  : row["label"].get<std::string>();
+      // What else the study varies, so that rows differing only there can be told apart.
+      for (const auto& [path, value] : row["varied"].items())
+        if (path != "scheme.tol" || conservation)
+          name += fmt::format(" {}={}", path.substr(path.rfind('.') + 1),
+                              value.is_string() ? value.get<std::string>() : value.dump());
       if (conservation) {
         s += fmt::format("  {:<24}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}", name, fraction(row["eps"]), fraction(row["h"]),
                          cell(row["err_H"]), cell(row["drift_H"], "{:.2e}"), cell(row["err_I"]), cell(row["err_m"]));
