@@ -383,30 +383,37 @@ std::string study_text(const Study& study, const Json& rows) {
     const auto declared_width = [](const std::string& c) {
       return static_cast<int>(std::max<size_t>(11, c.size() + 5));
     };
-    s += conservation ? fmt::format("\n  {:<24}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}", "scheme", "eps", "h", "max err_H",
+    // A row's name: its scheme (or label) and what else the study varies, so that rows
+    // differing only there can be told apart.
+    const auto row_name = [conservation](const Json& row) {
+      std::string name = row["label"].get<std::string>().empty() ? row["scheme"].get<std::string>()
+                                                                 : row["label"].get<std::string>();
+      for (const auto& [path, value] : row["varied"].items())
+        if (path != "scheme.tol" || conservation)
+          name += fmt::format(" {}={}", path.substr(path.rfind('.') + 1),
+                              value.is_string() ? value.get<std::string>() : value.dump());
+      return name;
+    };
+    size_t width = 24;
+    for (const auto& row : rows) width = std::max(width, row_name(row).size() + 2);
+    s += conservation ? fmt::format("\n  {:<{}}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}", "scheme", width, "eps", "h", "max err_H",
                                     "drift_H", "max err_I", "max err_m")
-                      : fmt::format("\n  {:<24}{:>10}{:>9}{:>10}{:>11}{:>12}{:>10}\n", "scheme", "eps", "h", "tol",
+                      : fmt::format("\n  {:<{}}{:>10}{:>9}{:>10}{:>11}{:>12}{:>10}\n", "scheme", width, "eps", "h", "tol",
                                     "error", "rhs evals", "wall s");
     if (conservation) {
       for (const auto& c : declared) s += fmt::format("{:>{}}", "max " + c, declared_width(c));
       s += fmt::format("{:>11}  {}\n", "t reached", "status");
     }
     for (const auto& row : rows) {
-      std::string name = row["label"].get<std::string>().empty() ? row["scheme"].get<std::string>()
-                                                                 : row["label"].get<std::string>();
-      // What else the study varies, so that rows differing only there can be told apart.
-      for (const auto& [path, value] : row["varied"].items())
-        if (path != "scheme.tol" || conservation)
-          name += fmt::format(" {}={}", path.substr(path.rfind('.') + 1),
-                              value.is_string() ? value.get<std::string>() : value.dump());
+      const std::string name = row_name(row);
       if (conservation) {
-        s += fmt::format("  {:<24}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}", name, fraction(row["eps"]), fraction(row["h"]),
+        s += fmt::format("  {:<{}}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}", name, width, fraction(row["eps"]), fraction(row["h"]),
                          cell(row["err_H"]), cell(row["drift_H"], "{:.2e}"), cell(row["err_I"]), cell(row["err_m"]));
         for (const auto& c : declared) s += fmt::format("{:>{}}", cell(row.value(c, Json())), declared_width(c));
         s += fmt::format("{:>11}  {}\n", cell(row["t_reached"], "{:g}"), row["status"].get<std::string>());
       } else {
         const Json tol = row["varied"].value("scheme.tol", Json());
-        s += fmt::format("  {:<24}{:>10}{:>9}{:>10}{:>11}{:>12}{:>10}\n", name, fraction(row["eps"]),
+        s += fmt::format("  {:<{}}{:>10}{:>9}{:>10}{:>11}{:>12}{:>10}\n", name, width, fraction(row["eps"]),
                          fraction(row["h"]), tol.is_number() ? fmt::format("{:.0e}", tol.get<double>()) : "",
                          cell(row["error"]), row["rhs_evals"].is_number() ? row["rhs_evals"].dump() : "-",
                          cell(row["wall_seconds"], "{:.4f}"));
