@@ -3,9 +3,13 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "tsi/assembly.hpp"
 #include "tsi/error.hpp"
@@ -73,14 +77,63 @@ const ParamSchema& monitor_schema() {
 
 }  // namespace
 
+Json parse_json(std::istream& in, const std::string& origin) {
+  // The parser's callback sees every key and nesting level: a duplicated key (which the parser
+  // would silently resolve to the last value) and nesting deeper than any config needs are
+  // refused, naming where; the key path also names a number that overflows a double.
+  constexpr std::size_t max_depth = 64;
+  std::vector<std::set<std::string>> keys;  // per open object (empty sets stand for arrays)
+  std::vector<std::string> path;            // the key or index path to the current value
+  std::string last_key;
+  const auto where = [&] {
+    std::string p;
+    for (const auto& k : path) p += (p.empty() ? "" : ".") + k;
+    return p.empty() ? origin : origin + ": " + p;
+  };
+  const Json::parser_callback_t check = [&](int, Json::parse_event_t event, Json& parsed) {
+    switch (event) {
+      case Json::parse_event_t::object_start:
+      case Json::parse_event_t::array_start:
+        if (keys.size() >= max_depth)
+          throw ConfigError(where(), fmt::format("nested deeper than {} levels; no config needs that", max_depth));
+        if (!keys.empty()) path.push_back(last_key);
+        keys.emplace_back();
+        last_key = "[]";
+        break;
+      case Json::parse_event_t::object_end:
+      case Json::parse_event_t::array_end:
+        keys.pop_back();
+        if (!path.empty()) path.pop_back();
+        break;
+      case Json::parse_event_t::key: {
+        const std::string key = parsed.get<std::string>();
+        if (!keys.back().insert(key).second)
+          throw ConfigError(where(), "duplicate key \"" + key + "\": each key may appear once in an object");
+        last_key = key;
+        break;
+      }
+      case Json::parse_event_t::value:
+        break;
+    }
+    return true;
+  };
+  try {
+    return Json::parse(in, check, true, /*ignore_comments=*/true);
+  } catch (const Json::parse_error& e) {
+    throw ConfigError(origin, std::string("malformed JSON: ") + e.what());
+  } catch (const Json::out_of_range&) {
+    const std::string field = last_key.empty() || last_key == "[]" ? where() : where() + "." + last_key;
+    throw ConfigError(field, "a number out of the range of a double (at most about 1.8e308 in magnitude)");
+  }
+}
+
 Json load_config_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw ConfigError(path, "is a directory, expected a JSON config file");
   std::ifstream in(path);
   if (!in) throw ConfigError(path, "cannot open the config file (missing or unreadable)");
-  try {
-    return Json::parse(in, nullptr, true, /*ignore_comments=*/true);
-  } catch (const Json::parse_error& e) {
-    throw ConfigError(path, std::string("malformed JSON: ") + e.what());
-  }
+  return parse_json(in, path);
 }
 
 void apply_override(Json& config, const std::string& assignment) {
@@ -90,8 +143,10 @@ void apply_override(Json& config, const std::string& assignment) {
   const std::string path = assignment.substr(0, eq), text = assignment.substr(eq + 1);
   Json value;
   try {
-    value = Json::parse(text);
-  } catch (const Json::parse_error&) {
+    std::istringstream in(text);
+    value = parse_json(in, "--set " + path);
+  } catch (const ConfigError& e) {
+    if (std::string(e.what()).find("malformed JSON") == std::string::npos) throw;
     value = text;  // a bare word is a string
   }
   assign_path(config, path, value, "--set " + path);
@@ -105,6 +160,9 @@ void assign_path(Json& config, const std::string& path, const Json& value, const
     keys.push_back(key);
   }
   if (keys.empty()) throw ConfigError(origin, "empty key path");
+  if (keys.size() > 16)
+    throw ConfigError(origin.substr(0, 80), fmt::format("a key path of {} components; no config is deeper than a few",
+                                                        keys.size()));
   if (std::find(sections.begin(), sections.end(), keys.front()) == sections.end())
     throw ConfigError(origin, "unknown section \"" + keys.front() + "\"; valid sections are: " + join(sections));
   Json* node = &config;
@@ -150,6 +208,15 @@ Json resolve_run_config(const Json& raw, const Registry& registry) {
     if (!ref_scheme.traits.adaptive && ref["h"].is_null())
       throw ConfigError("reference.h", "the reference scheme \"" + ref_scheme.info.name +
                                            "\" is not adaptive: give its step h");
+    if (ref["h"].is_number()) {  // a reference step that does not divide t_end would run another step
+      const double t_end = out["time"]["t_end"], h = ref["h"];
+      const double steps = t_end / h;
+      if (t_end > 0.0 && (!(h <= t_end) || std::abs(steps - std::round(steps)) > 1e-9 * std::max(1.0, steps)))
+        throw ConfigError("reference.h", fmt::format("got {}, expected t_end / n for a whole number n of steps "
+                                                     "(t_end = {}: {:.6g} steps)",
+                                                     h, t_end, steps));
+      if (steps > 1e12) throw ConfigError("reference.h", fmt::format("t_end / h = {:.3g} steps is too many", steps));
+    }
     out["reference"] = ref;
   }
 
@@ -172,6 +239,10 @@ long step_count(const Json& resolved) {
   const double h = resolved.at("time").at("h"), t_end = resolved.at("time").at("t_end");
   const double steps = t_end / h;
   const double whole = std::round(steps);
+  if (t_end > 0.0 && !(h <= t_end))
+    throw ConfigError("time.h", fmt::format("got {}, expected at most t_end = {} (a run of no step would compare "
+                                            "the initial state with the reference at t_end)",
+                                            h, t_end));
   if (std::abs(steps - whole) > 1e-9 * std::max(1.0, steps))
     throw ConfigError("time.h", fmt::format("t_end = {} is not a whole number of steps of h = {} "
                                             "({:.6g} steps); choose h = t_end / n",

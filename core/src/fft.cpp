@@ -1,5 +1,7 @@
 #include "tsi/fft.hpp"
 
+#include <fmt/format.h>
+
 #include <fftw3.h>
 
 #include <atomic>
@@ -29,13 +31,21 @@ FftBatch::FftBatch(int n, int howmany) : n_(n), howmany_(howmany) {
   const long values = static_cast<long>(n) * howmany;
   fftw_plan_with_nthreads(threads_ready && values >= threads_min_values ? threads_setting.load() : 1);
   buffer_ = reinterpret_cast<Complex*>(fftw_alloc_complex(static_cast<size_t>(n) * howmany));
+  if (!buffer_)
+    throw Error(fmt::format("FftBatch: cannot allocate {} x {} complex values ({:.3g} GB)", n, howmany,
+                            16.0 * static_cast<double>(values) / 1e9));
   auto* raw = reinterpret_cast<fftw_complex*>(buffer_);
   // Transform along tau: n points with stride howmany, one transform per component.
   forward_plan_ = fftw_plan_many_dft(1, &n_, howmany_, raw, nullptr, howmany_, 1, raw, nullptr,
                                      howmany_, 1, FFTW_FORWARD, FFTW_ESTIMATE);
   backward_plan_ = fftw_plan_many_dft(1, &n_, howmany_, raw, nullptr, howmany_, 1, raw, nullptr,
                                       howmany_, 1, FFTW_BACKWARD, FFTW_ESTIMATE);
-  if (!forward_plan_ || !backward_plan_) throw Error("FftBatch: FFTW could not make a plan");
+  if (!forward_plan_ || !backward_plan_) {  // the destructor will not run: release what was made
+    if (forward_plan_) fftw_destroy_plan(static_cast<fftw_plan>(forward_plan_));
+    if (backward_plan_) fftw_destroy_plan(static_cast<fftw_plan>(backward_plan_));
+    fftw_free(buffer_);
+    throw Error("FftBatch: FFTW could not make a plan");
+  }
   data().setZero();
 }
 

@@ -16,7 +16,8 @@ ParamSchema fixed_point_params() {
           number_param("tol", 1e-10, "fixed-point tolerance on the relative max-norm increment")
               .range(0.0, 1.0, true, true),
           integer_param("max_iter", 200, "most fixed-point sweeps per implicit stage")
-              .check([](const Json& v) { return v.get<long>() >= 1; }, "a positive integer"),
+              .check([](const Json& v) { return v.get<long>() >= 1 && v.get<long>() <= 1000000; },
+                     "an integer from 1 to 1000000"),
           integer_param("anderson_depth", 3, "Anderson: previous residuals mixed into each update")
               .check([](const Json& v) { return v.get<long>() >= 1 && v.get<long>() <= 8; },
                      "an integer from 1 to 8"),

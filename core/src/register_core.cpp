@@ -22,8 +22,8 @@ void register_core(Registry& registry) {
       {"2scale", "tsi"},
       "U(t, tau) with dU/dt + (1/eps) dU/dtau = f_tau(U), Fourier in tau (eq. 2scale eq)",
       {integer_param("n_tau", nullptr, "Fourier points in tau; default: the model's own")
-           .check([](const Json& v) { return v.get<long>() > 0 && v.get<long>() % 2 == 0; },
-                  "a positive even integer"),
+           .check([](const Json& v) { return v.get<long>() > 0 && v.get<long>() <= (1L << 20) && v.get<long>() % 2 == 0; },
+                  "an even integer from 2 to 1048576"),
        integer_param("initial_data_order", nullptr,
                      "order of the prepared initial data (1, 2 or 3); default: what the scheme "
                      "needs for uniform second order")
@@ -43,7 +43,8 @@ void register_core(Registry& registry) {
                     "from the data prepared at its own diagonal value")
            .range(0.0, 1e300, true, false),
        integer_param("reprepare_min_gap", 10, "auto: test (one evaluation of r1) every this many steps")
-           .check([](const Json& v) { return v.get<long>() >= 1; }, "a positive integer")},
+           .check([](const Json& v) { return v.get<long>() >= 1 && v.get<long>() <= 1000000000; },
+                  "an integer from 1 to 1e9")},
       ""};
   two_scale.complete = [](Json& p, const Selection& s) {
     if (p["n_tau"].is_null()) p["n_tau"] = s.model.default_n_tau;

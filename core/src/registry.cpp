@@ -106,7 +106,8 @@ void Registry::add_model(ModelEntry entry) {
   if (!has_param(params, "eps")) {
     params.push_back(
         number_param("eps", 0.01, "the small parameter: stiffness 1/eps of the linear part")
-            .range(0.0, 1.0, true, false));
+            .check([](const Json& v) { return v.get<double>() >= 1e-300 && v.get<double>() <= 1.0; },
+                   "a number in (0, 1], at least 1e-300 (1/eps must be a finite double)"));
   }
   if (!has_param(params, "u0")) {
     params.push_back(

@@ -71,6 +71,6 @@ TEST_CASE("study: bad kinds, lists and paths are rejected before anything runs")
   rejects({{"base", base()}, {"vary", {{"time.h", tsi::Json::array()}}}}, "vary.time.h: got [], expected a non-empty list");
   rejects({{"base", base()}, {"vary", {{"model.epz", {1.0}}}}}, "model.epz: unknown parameter");
   rejects({{"base", base()}, {"vary", {{"nosuch.x", {1.0}}}}}, "unknown section \"nosuch\"");
-  rejects({{"base", base()}, {"vary", {{"model.eps", {0.5, 2.0}}}}}, "got 2.0, expected a number in (0, 1] (run r0002: model.eps=2.0)");
+  rejects({{"base", base()}, {"vary", {{"model.eps", {0.5, 2.0}}}}}, "got 2.0, expected a number in (0, 1], at least 1e-300 (1/eps must be a finite double) (run r0002: model.eps=2.0)");
   rejects({{"base", base()}, {"bogus", 1}}, "unknown study key");
 }

@@ -2,6 +2,7 @@
 // "tsi: error: FIELD: ..." that names the field, the offending value and what was expected.
 #include <doctest/doctest.h>
 
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -121,11 +122,11 @@ TEST_CASE("run errors: t_end that is not a whole number of steps") {
 TEST_CASE("run errors: n_tau must be a positive even integer") {
   SUBCASE("odd") {
     check_bad_input(run_example_with({"reformulation.n_tau=63"}), "reformulation.n_tau",
-                    {"got 63", "positive even integer"});
+                    {"got 63", "even integer from 2 to 1048576"});
   }
   SUBCASE("zero") {
     check_bad_input(run_example_with({"reformulation.n_tau=0"}), "reformulation.n_tau",
-                    {"got 0", "positive even integer"});
+                    {"got 0", "even integer from 2 to 1048576"});
   }
   SUBCASE("not an integer") {
     check_bad_input(run_example_with({"reformulation.n_tau=2.5"}), "reformulation.n_tau",
@@ -133,8 +134,23 @@ TEST_CASE("run errors: n_tau must be a positive even integer") {
   }
   SUBCASE("negative") {
     check_bad_input(run_example_with({"reformulation.n_tau=-4"}), "reformulation.n_tau",
-                    {"got -4", "positive even integer"});
+                    {"got -4", "even integer from 2 to 1048576"});
   }
+  SUBCASE("beyond 32 bits: checked before it is narrowed, never run as 64") {
+    check_bad_input(run_example_with({"reformulation.n_tau=4294967360"}), "reformulation.n_tau",
+                    {"got 4294967360", "even integer from 2 to 1048576"});
+  }
+}
+
+TEST_CASE("run errors: time.h larger than t_end, and a reference step that does not divide t_end") {
+  check_bad_input(run_example_with({"time.h=1e10"}), "time.h", {"got 10000000000", "at most t_end"});
+  check_bad_input(run_example_with({"time.h=1e308"}), "time.h", {"at most t_end"});
+  check_bad_input(run_example_with({"reference={\"scheme\": \"se1\", \"reformulation\": \"two-scale\", \"h\": 0.3}"}),
+                  "reference.h", {"got 0.3", "whole number"});
+}
+
+TEST_CASE("run errors: eps too small for 1/eps to be a double") {
+  check_bad_input(run_example_with({"model.eps=5e-324"}), "model.eps", {"at least 1e-300"});
 }
 
 TEST_CASE("run errors: initial_data_order must be 1 2 or 3") {
@@ -148,7 +164,11 @@ TEST_CASE("run errors: scheme parameters are checked") {
   }
   SUBCASE("se1 max_iter = 0") {
     check_bad_input(run_example_with({"scheme.max_iter=0"}), "scheme.max_iter",
-                    {"got 0", "positive integer"});
+                    {"got 0", "integer from 1 to 1000000"});
+  }
+  SUBCASE("se1 max_iter = 2^32: never narrowed to zero sweeps") {
+    check_bad_input(run_example_with({"scheme.max_iter=4294967296"}), "scheme.max_iter",
+                    {"got 4294967296", "integer from 1 to 1000000"});
   }
 }
 
@@ -313,4 +333,43 @@ TEST_CASE("run errors: a complex u0 for a real model is bad input, never silentl
                                    "model.u0=[0.1, [0.1, 0.2], 0.1, 0.1]"});
   CHECK(r.exit_code == 2);
   CHECK(contains(r.err, "model.u0[1]: got [0.1,0.2], expected a real number"));
+}
+
+TEST_CASE("run errors: a config's JSON is read strictly, every problem named and none a crash") {
+  TempDir dir;
+  const auto run_text = [&](const std::string& text) {
+    const std::string path = dir / "config.json";
+    std::ofstream(path) << text;
+    return run_tsi({"run", path, "--out", dir / "out"});
+  };
+  SUBCASE("a duplicated key, which a parser would silently resolve to its last value") {
+    check_bad_input(run_text(R"({"model": {"name": "hh", "eps": 0.1, "eps": 0.5}})"), dir / "config.json: model",
+                    {"duplicate key \"eps\""});
+  }
+  SUBCASE("a number beyond a double names its field") {
+    check_bad_input(run_text(R"({"model": {"name": "hh", "eps": 1e400}})"), dir / "config.json: model.eps",
+                    {"out of the range of a double"});
+  }
+  SUBCASE("nesting 60000 deep is refused, not a stack overflow") {
+    check_bad_input(run_text(std::string(60000, '[') + std::string(60000, ']')), dir / "config.json",
+                    {"nested deeper than 64 levels"});
+  }
+  SUBCASE("a directory is not a config") {
+    const CommandResult r = run_tsi({"run", dir.path().string(), "--out", dir / "out"});
+    INFO(r.describe());
+    CHECK(r.signal == 0);
+    CHECK(r.exit_code == 2);
+    CHECK(contains(r.err, "is a directory"));
+  }
+  SUBCASE("--set: a value nested 60000 deep, and a key path of 60000 components") {
+    check_bad_input(run_example_with({"model.u0=" + std::string(60000, '[') + std::string(60000, ']')}),
+                    "--set model.u0", {"nested deeper than 64 levels"});
+    std::string path = "model";
+    for (int i = 0; i < 60000; ++i) path += ".a";
+    const CommandResult r = run_example_with({path + "=1"});
+    INFO(r.describe());
+    CHECK(r.signal == 0);
+    CHECK(r.exit_code == 2);
+    CHECK(contains(r.err, "a key path of 60001 components"));
+  }
 }

@@ -99,7 +99,7 @@ TEST_CASE("registry: every model gets eps and u0") {
   CHECK(resolved["u0"].is_null());
   CHECK_THROWS_WITH_AS(
       tsi::resolve_params(r.model("plain").info.params, tsi::Json{{"eps", 2}}, "model"),
-      "model.eps: got 2, expected a number in (0, 1]", tsi::ConfigError);
+      "model.eps: got 2, expected a number in (0, 1], at least 1e-300 (1/eps must be a finite double)", tsi::ConfigError);
 }
 
 TEST_CASE("registry: check_compatible names the compatible reformulations") {
