@@ -69,6 +69,14 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
       if (std::find(study.varied.begin(), study.varied.end(), path) == study.varied.end())
         study.varied.push_back(path);
 
+    // Its size, counted before anything is expanded (and in double: it may not fit a size_t).
+    double product = 1.0;
+    for (const auto& [path, values] : lists) product *= static_cast<double>(values.size());
+    product += static_cast<double>(study.runs.size());  // with the cases before this one
+    if (product > static_cast<double>(max_study_runs))
+      throw ConfigError(lists.empty() ? where : "vary", fmt::format("the study expands to {:.4g} runs; at most {} are "
+                                                                   "allowed: split it, or vary fewer values",
+                                                                   product, max_study_runs));
     // The cartesian product, last path fastest (an odometer over the lists).
     std::vector<size_t> index(lists.size(), 0);
     for (bool done = false; !done;) {

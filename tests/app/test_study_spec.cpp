@@ -74,3 +74,13 @@ TEST_CASE("study: bad kinds, lists and paths are rejected before anything runs")
   rejects({{"base", base()}, {"vary", {{"model.eps", {0.5, 2.0}}}}}, "got 2.0, expected a number in (0, 1], at least 1e-300 (1/eps must be a finite double) (run r0002: model.eps=2.0)");
   rejects({{"base", base()}, {"bogus", 1}}, "unknown study key");
 }
+
+TEST_CASE("study: a vary that expands to 1e10 runs is refused with the count, before anything is allocated") {
+  tsi::Json values = tsi::Json::array();
+  for (int i = 0; i < 100; ++i) values.push_back(0.5);
+  const tsi::Json spec = {{"base", {{"model", {{"name", "hh"}}}, {"time", {{"t_end", 1.0}}}}},
+                          {"vary", {{"model.eps", values}, {"time.h", values}, {"scheme.tol", values},
+                                    {"monitor.max_err_H", values}, {"output.every", values}}}};
+  CHECK_THROWS_WITH_AS(tsi::app::expand_study(spec, registry(), {}),
+                       doctest::Contains("the study expands to 1e+10 runs; at most 100000"), tsi::ConfigError);
+}
