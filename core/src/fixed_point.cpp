@@ -41,7 +41,9 @@ FixedPointOptions fixed_point_options(const Params& params) {
 }
 
 FixedPointSolver::FixedPointSolver(FixedPointOptions options) : options_(std::move(options)) {
-  stats_.sweeps_histogram.assign(static_cast<size_t>(options_.max_iter) + 1, 0);
+  // Grown to the largest count seen, not sized by max_iter (up to 1e6: 8 MB per solver for a
+  // histogram whose counts sit below a few dozen).
+  stats_.sweeps_histogram.assign(static_cast<size_t>(std::min(options_.max_iter, 64)) + 1, 0);
 }
 
 bool FixedPointSolver::solve(Vector& x, FixedPointMap g) {
@@ -52,6 +54,8 @@ bool FixedPointSolver::solve(Vector& x, FixedPointMap g) {
   ++stats_.solves;
   stats_.iterations += used;
   stats_.iterations_max = std::max(stats_.iterations_max, used);
+  if (static_cast<size_t>(used) >= stats_.sweeps_histogram.size())
+    stats_.sweeps_histogram.resize(static_cast<size_t>(used) + 1, 0);
   ++stats_.sweeps_histogram[static_cast<size_t>(used)];
   if (!converged) {
     ++stats_.not_converged;
