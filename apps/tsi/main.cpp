@@ -35,6 +35,7 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
     tsi::app::load_config_plugins(loader, raw["plugins"], config_path);
   const Json config = tsi::app::resolve_run_config(raw, registry);
   if (out_dir.empty()) out_dir = "out/" + std::filesystem::path(config_path).stem().string();
+  tsi::app::prepare_output_dir(out_dir);
 
   const bool tty = isatty(fileno(stderr));
   auto progress = [&](double fraction) {

@@ -11,6 +11,7 @@
 
 #include "config.hpp"
 #include "plugin_setup.hpp"
+#include "run_files.hpp"
 #include "study_report.hpp"
 #include "study_runner.hpp"
 
@@ -40,6 +41,7 @@ int study_command(PluginLoader& loader, Registry& registry, const std::string& s
     load_config_plugins(loader, spec["base"]["plugins"], study_path);
   const Study study = expand_study(spec, registry, overrides);
   if (out_dir.empty()) out_dir = "out/" + std::filesystem::path(study_path).stem().string();
+  prepare_output_dir(out_dir);
   if (jobs <= 0) jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 
   const bool tty = isatty(fileno(stderr));

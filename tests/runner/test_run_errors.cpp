@@ -373,3 +373,22 @@ TEST_CASE("run errors: a config's JSON is read strictly, every problem named and
     CHECK(contains(r.err, "a key path of 60001 components"));
   }
 }
+
+TEST_CASE("run errors: an --out that cannot hold the results is refused before anything is computed") {
+  TempDir dir;
+  const std::string file = dir / "taken";
+  std::ofstream(file) << "not a directory\n";
+  for (const std::string& out : {file, file + "/sub"}) {
+    const CommandResult r = run_tsi({"run", example_config(), "--out", out, "--set", "time.t_end=1000"});
+    INFO(r.describe());
+    CHECK(r.signal == 0);
+    CHECK(r.exit_code == 2);
+    CHECK(contains(r.err, "tsi: error: --out:"));
+    CHECK_FALSE(contains(r.out, "running"));
+  }
+  const CommandResult study = run_tsi({"study", (fs::path(TSI_TEST_SOURCE_DIR) / "examples/paper/hh-convergence.json").string(),
+                                       "--out", file, "--no-plots"});
+  INFO(study.describe());
+  CHECK(study.exit_code == 2);
+  CHECK(contains(study.err, "tsi: error: --out:"));
+}
