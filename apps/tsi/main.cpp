@@ -12,6 +12,7 @@
 #include <filesystem>
 
 #include "check_command.hpp"
+#include "interrupt.hpp"
 #include "config.hpp"
 #include "list_command.hpp"
 #include "plugin_setup.hpp"
@@ -136,9 +137,17 @@ int main(int argc, char** argv) {
       check_options.model_params = model_overrides["model"];
       return tsi::app::check_command(loader, registry, check_options, plugin_files);
     }
-    if (study->parsed())
-      return tsi::app::study_command(loader, registry, study_path, study_out, jobs, study_overrides, !no_plots);
-    return run_command(loader, registry, config_path, out_dir, overrides);
+    // A run or study stops at its next step on SIGINT or SIGTERM and writes what it has; the
+    // exit code is then the shell's for that signal (128 + signal), after the files are on disk.
+    tsi::app::install_interrupt_handlers();
+    const int rc = study->parsed()
+                       ? tsi::app::study_command(loader, registry, study_path, study_out, jobs, study_overrides, !no_plots)
+                       : run_command(loader, registry, config_path, out_dir, overrides);
+    if (tsi::app::interrupted()) {
+      spdlog::error("interrupted by signal {}: what was computed is written", tsi::app::interrupt_signal());
+      return 128 + tsi::app::interrupt_signal();
+    }
+    return rc;
   } catch (const tsi::Error& e) {
     spdlog::error("{}", e.what());
     return 2;

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "config.hpp"
+#include "interrupt.hpp"
 #include "run_recorder.hpp"
 #include "tsi/assembly.hpp"
 #include "tsi/phase.hpp"
@@ -46,7 +47,12 @@ Vector reference_model_state(const Json& config, const Registry& registry, doubl
   if (t_end > 0.0) {
     const double h = ref["h"].is_null() ? t_end : ref["h"].get<double>() / substep_factor;
     const long steps = std::max(1L, std::lround(t_end / h));
-    integrate(*a.reformulation, *a.stepper, y, t_end / static_cast<double>(steps), steps, {});
+    integrate(*a.reformulation, *a.stepper, y, t_end / static_cast<double>(steps), steps,
+              [](long, double t, const Vector&) {
+                if (interrupted())
+                  throw Error(fmt::format("interrupted by signal {} at t = {:.6g}", interrupt_signal(), t));
+                return true;
+              });
   }
   return a.reformulation->read_back(y, t_end);
 }
@@ -134,13 +140,19 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
     Vector y = reformulation->prepare(u0);
     integrate(*reformulation, *stepper, y, h, n_steps, [&](long n, double t, const Vector& state) {
       const bool go_on = recorder.observe(n, t, state);
+      if (go_on && interrupted()) {  // kept up to this step, and written as "interrupted"
+        status = "interrupted";
+        outcome.message = fmt::format("interrupted by signal {} at t = {:.6g} (step {} of {})", interrupt_signal(),
+                                      t, n, n_steps);
+        return false;
+      }
       if (progress && seconds_since(last_progress) > 0.5) {
         progress(static_cast<double>(n) / static_cast<double>(std::max(1L, n_steps)));
         last_progress = Clock::now();
       }
       return go_on;
     });
-    if (recorder.status() != "running") {
+    if (status == "completed" && recorder.status() != "running") {
       status = recorder.status();
       outcome.message = recorder.message();
     }

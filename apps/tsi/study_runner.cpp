@@ -1,10 +1,13 @@
 #include "study_runner.hpp"
 
+#include <fmt/format.h>
+
 #include <atomic>
 #include <map>
 #include <mutex>
 #include <thread>
 
+#include "interrupt.hpp"
 #include "tsi/fft.hpp"
 #include "tsi/version.hpp"
 
@@ -82,6 +85,12 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
         return;
       }
       reference = &references[r];
+    }
+    if (interrupted()) {  // not started: the study was interrupted
+      outcomes[i] = failed_outcome(run, fmt::format("not run: the study was interrupted by signal {}", interrupt_signal()));
+      outcomes[i].result["status"] = "interrupted";
+      tick();
+      return;
     }
     try {
       outcomes[i] = execute_run(run.config, registry, {}, reference);

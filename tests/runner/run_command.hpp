@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -52,6 +53,8 @@ struct CommandResult {
 struct CommandEnv {
   std::map<std::string, std::string> set;  ///< variables to set (or replace)
   std::vector<std::string> unset;          ///< variables to remove
+  int send_signal = 0;                     ///< a signal to send the child (0: none) ...
+  double signal_after_seconds = 0.0;       ///< ... this long after it started
 };
 
 namespace detail {
@@ -121,13 +124,20 @@ inline CommandResult run_command(const std::string& program, const std::vector<s
   }
 
   CommandResult result;
+  const auto started = std::chrono::steady_clock::now();
+  bool signalled = env.send_signal == 0;
   int fds[2] = {out_pipe[0], err_pipe[0]};
   std::string* sinks[2] = {&result.out, &result.err};
   char buffer[4096];
   while (fds[0] >= 0 || fds[1] >= 0) {
     pollfd polls[2];
     for (int k = 0; k < 2; ++k) polls[k] = {fds[k], POLLIN, 0};  // a negative fd is ignored
-    if (::poll(polls, 2, -1) < 0) {
+    if (!signalled && std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() >=
+                          env.signal_after_seconds) {
+      ::kill(pid, env.send_signal);
+      signalled = true;
+    }
+    if (::poll(polls, 2, signalled ? -1 : 20) < 0) {
       if (errno == EINTR) continue;
       break;
     }
