@@ -42,7 +42,7 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
   auto progress = [&](double fraction) {
     if (tty) fmt::print(stderr, "\r  running: {:5.1f}%", 100.0 * fraction);
   };
-  const tsi::app::RunOutcome outcome = tsi::app::execute_run(config, registry, progress);
+  const tsi::app::RunOutcome outcome = tsi::app::execute_run(config, registry, progress, nullptr, out_dir);
   if (tty) fmt::print(stderr, "\r{:30}\r", "");
   tsi::app::write_run_files(out_dir, outcome);
   fmt::print("{}", tsi::app::run_summary(outcome, out_dir));

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 
 #include "config.hpp"
@@ -106,7 +107,7 @@ Json state_to_json(const Vector& x, bool complex_state) {
 }
 
 RunOutcome execute_run(const Json& config, const Registry& registry, const ProgressFn& progress,
-                       const ReferenceSolution* shared_reference) {
+                       const ReferenceSolution* shared_reference, const std::string& stream_dir) {
   RunOutcome outcome;
   Json& result = outcome.result;
   result["tsi_version"] = version_string;
@@ -133,7 +134,13 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
 
   const double h = config["time"]["h"], t_end = config["time"]["t_end"];
   const long n_steps = step_count(config);
-  RunRecorder recorder(*model, *reformulation, u0, config);
+  if (!stream_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(stream_dir, ec);
+    if (ec) throw Error("cannot create " + stream_dir + ": " + ec.message());
+    outcome.csv_file = stream_dir + "/invariants.csv.partial";
+  }
+  RunRecorder recorder(*model, *reformulation, u0, config, outcome.csv_file);
   std::string status = "completed";
   auto last_progress = Clock::now();
   try {
@@ -174,6 +181,13 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   result["t_reached"] = recorder.t_reached();
   result["u_final"] = state_to_json(x, model->is_complex());
   result["invariants"] = recorder.invariants_json();
+  {
+    const char* names[3] = {"H", "I", "m"};
+    for (int k = 0; k < 3; ++k) {
+      const double d = recorder.drift(k);
+      result["invariants"][names[k]]["drift"] = std::isnan(d) ? Json() : Json(d);
+    }
+  }
   const SolverStats stats = stepper->stats();
   Json histogram = Json::object();
   for (size_t k = 0; k < stats.sweeps_histogram.size(); ++k)

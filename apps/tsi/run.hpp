@@ -10,7 +10,8 @@ namespace tsi::app {
 /// Everything a run produced, kept even when it failed part-way.
 struct RunOutcome {
   Json result;       ///< the content of result.json
-  std::string csv;   ///< the content of invariants.csv
+  std::string csv;       ///< the content of invariants.csv (when it was not streamed to csv_file)
+  std::string csv_file;  ///< where its rows were streamed as they were computed (empty: in csv)
   bool ok = true;
   std::string message;  ///< why the run failed (empty when ok)
 };
@@ -39,8 +40,10 @@ using ProgressFn = std::function<void(double fraction)>;
 /// the registry, integrates, records the invariants, and compares with the reference when
 /// one is requested (computing it unless `reference` is given). Errors during the run are
 /// caught and reported in the outcome; bad input (ConfigError) propagates.
+/// With `stream_dir`, the rows of invariants.csv are written to
+/// stream_dir/invariants.csv.partial as they are computed (write_run_files renames it).
 RunOutcome execute_run(const Json& resolved, const Registry& registry, const ProgressFn& progress = {},
-                       const ReferenceSolution* reference = nullptr);
+                       const ReferenceSolution* reference = nullptr, const std::string& stream_dir = "");
 
 /// The physical state as JSON: real numbers, or [re, im] pairs for a complex model.
 Json state_to_json(const Vector& x, bool complex_state);

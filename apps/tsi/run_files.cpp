@@ -29,7 +29,12 @@ void write_run_files(const std::string& dir, const RunOutcome& outcome) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error("--out " + dir + ": cannot create the output directory: " + ec.message());
-  write_file_atomically(dir + "/invariants.csv", outcome.csv);
+  if (outcome.csv_file.empty()) {
+    write_file_atomically(dir + "/invariants.csv", outcome.csv);
+  } else {  // streamed while the run went: complete now
+    std::filesystem::rename(outcome.csv_file, dir + "/invariants.csv", ec);
+    if (ec) throw Error("cannot rename " + outcome.csv_file + " to " + dir + "/invariants.csv: " + ec.message());
+  }
   write_file_atomically(dir + "/result.json", outcome.result.dump(2) + "\n");
 }
 

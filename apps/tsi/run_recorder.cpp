@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "config.hpp"
@@ -33,7 +34,7 @@ void check_invariant_name(const std::string& name, const std::string& column, co
 }  // namespace
 
 RunRecorder::RunRecorder(const Model& model, Reformulation& reformulation, const Vector& u0,
-                         const Json& config)
+                         const Json& config, const std::string& csv_path)
     : model_(model),
       reformulation_(reformulation),
       every_(config["output"]["every"]),
@@ -61,6 +62,35 @@ RunRecorder::RunRecorder(const Model& model, Reformulation& reformulation, const
   csv_.pop_back();  // the header's newline
   for (const auto& d : declared_) csv_ += "," + d.invariant.name + "," + d.column;
   csv_ += "\n";
+  drift_from_ = 0.1 * static_cast<double>(config["time"]["t_end"]);  // as the study reports have it
+  if (!csv_path.empty()) {
+    csv_file_.open(csv_path, std::ios::out | std::ios::trunc);
+    if (!csv_file_) throw Error("cannot write " + csv_path);
+    const std::string header = csv_;
+    csv_.clear();
+    write_row(header);
+  }
+}
+
+void RunRecorder::write_row(const std::string& row) {
+  if (!csv_file_.is_open()) {
+    csv_ += row;
+    return;
+  }
+  csv_file_ << row;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_flush_ > std::chrono::seconds(1)) {  // on disk within a second of being computed
+    csv_file_.flush();
+    last_flush_ = now;
+  }
+  if (!csv_file_) throw Error("writing invariants.csv failed (disk full?)");
+}
+
+double RunRecorder::drift(int k) const {
+  const double* s = drift_sums_[k];
+  const double denominator = s[0] * s[3] - s[1] * s[1];
+  return s[0] >= 2 && denominator > 0 ? (s[0] * s[4] - s[1] * s[2]) / denominator
+                                      : std::numeric_limits<double>::quiet_NaN();
 }
 
 bool RunRecorder::observe(long n, double t, const Vector& y) {
@@ -115,10 +145,17 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
   }
   const bool blow_up = errors[0] > max_err_H_;
   if (n % every_ == 0 || n == n_steps_ || blow_up) {
-    csv_ += fmt::format("{:.17g},{:.17g},{:.17g},{:.17g},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}", t, values[0],
-                        values[1], values[2], errors[0], errors[1], errors[2], roughness, spread);
-    for (const auto& d : declared_) csv_ += fmt::format(",{:.17g},{:.6e}", d.final, d.change);
-    csv_ += "\n";
+    std::string row = fmt::format("{:.17g},{:.17g},{:.17g},{:.17g},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}", t, values[0],
+                                  values[1], values[2], errors[0], errors[1], errors[2], roughness, spread);
+    for (const auto& d : declared_) row += fmt::format(",{:.17g},{:.6e}", d.final, d.change);
+    write_row(row + "\n");
+    if (t >= drift_from_)
+      for (int k = 0; k < 3; ++k) {
+        // The printed value, as a drift fitted to the file would see it.
+        const double printed = std::stod(fmt::format("{:.6e}", errors[k]));
+        double* s = drift_sums_[k];
+        s[0] += 1, s[1] += t, s[2] += printed, s[3] += t * t, s[4] += t * printed;
+      }
   }
   if (blow_up) {
     status_ = "blow-up";

@@ -1,4 +1,6 @@
 #pragma once
+#include <chrono>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -20,7 +22,10 @@ class RunRecorder {
   /// data: its rounding would make a relative change meaningless).
   static constexpr double relative_change_threshold = 1e-12;
 
-  RunRecorder(const Model& model, Reformulation& reformulation, const Vector& u0, const Json& config);
+  /// With a `csv_path`, the rows of invariants.csv go to that file as they are made (flushed
+  /// at least every second), not into memory: a run killed part-way leaves them on disk.
+  RunRecorder(const Model& model, Reformulation& reformulation, const Vector& u0, const Json& config,
+              const std::string& csv_path = "");
 
   /// The step observer: false stops the integration.
   bool observe(long n, double t, const Vector& y);
@@ -37,7 +42,11 @@ class RunRecorder {
   double roughness_max() const { return roughness_max_; }
   double spread_max() const { return spread_max_; }
   const Json& warnings() const { return warnings_; }
+  /// The rows of invariants.csv (empty when they were streamed to csv_path).
   const std::string& csv() const { return csv_; }
+  /// Least-squares slope of the relative change of H, I, m (k = 0, 1, 2) against t over the
+  /// rows with t >= drift_from (NaN with fewer than two): the drift a study reports.
+  double drift(int k) const;
 
  private:
   struct Track {
@@ -62,6 +71,11 @@ class RunRecorder {
   double t_ = 0.0, roughness_max_ = 0.0, spread_max_ = 0.0, spread_baseline_ = 0.0;
   bool roughness_warned_ = false, spread_warned_ = false;
   std::string status_ = "running", message_, csv_;
+  std::ofstream csv_file_;  // open when streaming
+  std::chrono::steady_clock::time_point last_flush_ = std::chrono::steady_clock::now();
+  double drift_from_ = 0.0;
+  double drift_sums_[3][5] = {};  // per invariant: n, sum t, sum y, sum t^2, sum t y
+  void write_row(const std::string& row);
   Json warnings_ = Json::array();
 };
 

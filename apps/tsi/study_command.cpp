@@ -53,7 +53,7 @@ int study_command(PluginLoader& loader, Registry& registry, const std::string& s
     fmt::print(stderr, "\r  {}/{} done, {:.1f} s elapsed, about {:.0f} s to go   ", done, total, elapsed, estimate);
   };
   if (tty) fmt::print(stderr, "  {} runs on {} threads\n", study.runs.size(), jobs);
-  const auto outcomes = run_study(study, registry, jobs, progress);
+  const auto outcomes = run_study(study, registry, jobs, progress, out_dir);
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   if (tty) fmt::print(stderr, "\r{:70}\r", "");
 

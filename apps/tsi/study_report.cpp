@@ -146,7 +146,13 @@ Json study_rows(const Study& study, const std::vector<RunOutcome>& outcomes) {
                 {"status", r.value("status", std::string("failed"))},
                 {"message", outcomes[i].message}};
     for (const char* x : {"H", "I", "m"}) {
-      const double slope = drift_slope(outcomes[i].csv, std::string("err_") + x, 0.1 * t_end);
+      // Fitted while the run went (its rows may be on disk only), else from the rows in memory.
+      const Json drift = outcomes[i].result.contains("invariants") && outcomes[i].result["invariants"].contains(x)
+                             ? outcomes[i].result["invariants"][x].value("drift", Json())
+                             : Json();
+      const double slope = outcomes[i].csv_file.empty() || !drift.is_number()
+                               ? drift_slope(outcomes[i].csv, std::string("err_") + x, 0.1 * t_end)
+                               : drift.get<double>();
       row[std::string("drift_") + x] = std::isfinite(slope) ? Json(slope) : Json();
     }
     // The model's own invariants: the largest change, under the name of its column in invariants.csv.

@@ -39,7 +39,7 @@ RunOutcome failed_outcome(const StudyRun& run, const std::string& message) {
 }  // namespace
 
 std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, int jobs,
-                                  const StudyProgressFn& progress) {
+                                  const StudyProgressFn& progress, const std::string& out_dir) {
   // Distinct references, each computed once.
   std::map<std::string, size_t> reference_index;
   std::vector<const Json*> reference_configs;
@@ -93,7 +93,8 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
       return;
     }
     try {
-      outcomes[i] = execute_run(run.config, registry, {}, reference);
+      outcomes[i] = execute_run(run.config, registry, {}, reference,
+                                out_dir.empty() ? std::string() : out_dir + "/runs/" + run.id);
     } catch (const std::exception& e) {
       outcomes[i] = failed_outcome(run, e.what());
     }

@@ -14,7 +14,8 @@ using StudyProgressFn = std::function<void(size_t done, size_t total)>;
 /// per distinct reference_key, and shared. A run that fails, or whose reference fails, is
 /// recorded as failed with its message and does not stop the others. Outcomes are in the
 /// order of study.runs.
+/// With `out_dir`, each run streams its invariants.csv rows into out_dir/runs/<id>/ as it goes.
 std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, int jobs,
-                                  const StudyProgressFn& progress = {});
+                                  const StudyProgressFn& progress = {}, const std::string& out_dir = "");
 
 }  // namespace tsi::app

@@ -57,3 +57,19 @@ TEST_CASE("interrupt: a study stopped by SIGINT writes its table with every run'
   CHECK(first.at("status") == "interrupted");
   CHECK(first.at("steps").get<long>() > 0);
 }
+
+TEST_CASE("interrupt: even SIGKILL leaves the rows computed more than a second before on disk") {
+  t::TempDir dir;
+  const t::Json config = {{"model", {{"name", "nls"}, {"eps", 0.1}, {"n_x", 64}}},
+                          {"scheme", {{"name", "se1"}}},
+                          {"time", {{"h", 0.01}, {"t_end", 1000.0}}}};
+  t::CommandEnv env;
+  env.send_signal = SIGKILL;
+  env.signal_after_seconds = 2.5;
+  const t::CommandResult r = t::run_tsi({"run", t::write_config(dir, config), "--out", dir / "out"}, env);
+  INFO(r.describe());
+  CHECK(r.signal == SIGKILL);
+  const std::string csv = t::read_text(dir.path() / "out" / "invariants.csv.partial");
+  CHECK(std::count(csv.begin(), csv.end(), '\n') > 10);  // streamed, flushed at least once a second
+  CHECK(t::contains(csv, "t,H,I,m,err_H"));
+}
