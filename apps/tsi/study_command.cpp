@@ -12,6 +12,7 @@
 #include "config.hpp"
 #include "plugin_setup.hpp"
 #include "run_files.hpp"
+#include "tsi/error.hpp"
 #include "study_report.hpp"
 #include "study_runner.hpp"
 
@@ -42,6 +43,26 @@ int study_command(PluginLoader& loader, Registry& registry, const std::string& s
   const Study study = expand_study(spec, registry, overrides);
   if (out_dir.empty()) out_dir = "out/" + std::filesystem::path(study_path).stem().string();
   prepare_output_dir(out_dir);
+  {
+    // One --out, one study: another study's results are never mixed with these; the same
+    // study again replaces its earlier runs (a smaller expansion would leave stale ones).
+    namespace fs = std::filesystem;
+    const fs::path previous = fs::path(out_dir) / "study.json";
+    std::error_code ec;
+    if (fs::exists(previous, ec)) {
+      Json earlier;
+      try {
+        earlier = load_config_file(previous.string()).value("study", Json());
+      } catch (const Error&) {
+        earlier = Json();
+      }
+      if (earlier != study.spec)
+        throw ConfigError("--out", "\"" + out_dir + "\" holds the results of another study (" +
+                                       (earlier.is_object() ? earlier.value("title", std::string("untitled")) : "unreadable") +
+                                       "); choose another --out, or remove that directory");
+    }
+    fs::remove_all(fs::path(out_dir) / "runs", ec);
+  }
   if (jobs <= 0) jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 
   const bool tty = isatty(fileno(stderr));

@@ -158,3 +158,26 @@ TEST_CASE("study: a bad path is rejected before any run, naming the run and the 
   CHECK(contains(r.err, "run r0001"));
   CHECK_FALSE(fs::exists(fs::path(out) / "table.csv"));
 }
+
+TEST_CASE("study: one --out holds one study: another is refused, the same one replaces its runs") {
+  TempDir dir;
+  const Json first = {{"kind", "convergence"},
+                      {"base", {{"model", {{"name", "hh"}}}, {"time", {{"t_end", 0.5}}}}},
+                      {"vary", {{"time.h", {0.25, 0.125}}}}};
+  Json second = first;
+  second["vary"]["time.h"] = {0.5};
+  const std::string out = dir / "out";
+  const auto a = run_tsi({"study", write_config(dir, first, "first.json"), "--out", out, "--no-plots"});
+  REQUIRE_MESSAGE(a.exit_code == 0, a.describe());
+  fs::create_directories(fs::path(out) / "runs" / "r9999");  // a stale run
+  const auto again = run_tsi({"study", write_config(dir, first, "first.json"), "--out", out, "--no-plots"});
+  INFO(again.describe());
+  CHECK(again.exit_code == 0);
+  CHECK_FALSE(fs::exists(fs::path(out) / "runs" / "r9999"));
+  CHECK(fs::exists(fs::path(out) / "runs" / "r0002" / "result.json"));
+  const auto other = run_tsi({"study", write_config(dir, second, "second.json"), "--out", out, "--no-plots"});
+  INFO(other.describe());
+  CHECK(other.exit_code == 2);
+  CHECK(contains(other.err, "holds the results of another study"));
+  CHECK(fs::exists(fs::path(out) / "runs" / "r0002" / "result.json"));  // untouched
+}
