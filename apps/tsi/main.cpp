@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
   app.add_option("--fft-threads", fft_threads,
                  "threads for each FFT batch of at least 65536 values (NLS from n_x = 256 with n_tau = 256; "
                  "measured 1.2x faster on 2 cores there, slower on smaller grids); default 1")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 1024));
 
   auto* list = app.add_subcommand("list", "list registered models, reformulations and schemes");
   std::string what;

@@ -83,6 +83,11 @@ void check_layout(const std::string& path, const TsiPluginLayout& theirs) {
                       std::to_string(theirs.eigen_max_align_bytes) + ", this tsi uses " +
                       std::to_string(ours.eigen_max_align_bytes) +
                       " (vectors cross the plugin boundary: build both with the same flags)");
+  if (theirs.address_sanitizer != ours.address_sanitizer)
+    throw PluginError(path + ": built " + (theirs.address_sanitizer ? "with" : "without") +
+                      " AddressSanitizer, this tsi " + (ours.address_sanitizer ? "with" : "without") +
+                      " it (Eigen allocates through another allocator under ASan, and vectors cross the "
+                      "plugin boundary: build both the same way)");
 }
 
 /// The plugin's info block, after the ABI, size, version and layout checks; throws the reason.

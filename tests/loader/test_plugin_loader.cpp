@@ -91,6 +91,11 @@ TEST_CASE("loader: the layout handshake covers the exchanged structures") {
   CHECK(layout.entry_info.size == sizeof(tsi::EntryInfo));
   CHECK(layout.entry_info.align == alignof(tsi::EntryInfo));
   CHECK(layout.eigen_max_align_bytes == EIGEN_MAX_ALIGN_BYTES);
+#if defined(__SANITIZE_ADDRESS__)
+  CHECK(layout.address_sanitizer == 1u);
+#else
+  CHECK(layout.address_sanitizer == 0u);
+#endif
   CHECK(TSI_PLUGIN_ABI_VERSION == 5);  // 4: the remainder, bind_tau_grid, invariants; 5: entry completion, needs_exact_flows
 }
 
@@ -138,7 +143,7 @@ TEST_CASE("loader: a directory scan collects failures without throwing") {
   const std::vector<std::pair<const char*, bool>> expected = {
       {"broken_flow", true}, {"broken_fused", true},      {"duplicate", true},        {"good", false},
       {"no_entry", false},   {"shipped_duplicate", true}, {"stiff", true},           {"throws", false},
-      {"wrong_abi", false},  {"wrong_layout", false},     {"wrong_major", false}};
+      {"wrong_abi", false},  {"wrong_layout", false},     {"wrong_major", false},     {"wrong_sanitizer", false}};
   REQUIRE(reports.size() == expected.size());
   for (std::size_t i = 0; i < reports.size(); ++i) {
     CAPTURE(reports[i].path);
@@ -172,4 +177,12 @@ TEST_CASE("loader: a path list loads files and collects failures") {
 
 TEST_CASE("loader: the default directory is known") {
   CHECK_FALSE(tsi::PluginLoader::default_directory().empty());
+}
+
+TEST_CASE("loader: a plugin built the other way round with respect to AddressSanitizer is refused") {
+  tsi::Registry r;
+  tsi::PluginLoader loader(r);
+  CHECK_THROWS_WITH_AS(loader.load(fixture("wrong_sanitizer")), doctest::Contains("AddressSanitizer"),
+                       tsi::PluginError);
+  CHECK(r.models().empty());
 }

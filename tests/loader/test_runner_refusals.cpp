@@ -64,7 +64,8 @@ TEST_CASE("runner: a refused plugin on TSI_PLUGIN_PATH is a warning, the shipped
   REQUIRE(r.exit_code == 0);
   CHECK(mentions(r.err, "already registered"));
   CHECK(mentions(r.err, "tsi::ModelEntry"));
-  for (const auto& m : t::Json::parse(r.out).at("models"))
+  const t::Json listed = t::Json::parse(r.out);  // named: a range-for over .at() of a temporary dangles
+  for (const auto& m : listed.at("models"))
     if (m.at("name") == "henon-heiles")
       CHECK(mentions(m.at("provider").get<std::string>(), "tsi_henon_heiles.so"));
 }

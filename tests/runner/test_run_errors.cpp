@@ -392,3 +392,11 @@ TEST_CASE("run errors: an --out that cannot hold the results is refused before a
   CHECK(study.exit_code == 2);
   CHECK(contains(study.err, "tsi: error: --out:"));
 }
+
+TEST_CASE("run errors: --fft-threads beyond 1024 is refused, not a run that never plans") {
+  const CommandResult r = run_tsi({"--fft-threads", "100000", "list", "models"});
+  INFO(r.describe());
+  CHECK(r.signal == 0);
+  CHECK(r.exit_code == 2);
+  CHECK(contains(r.err, "--fft-threads"));
+}

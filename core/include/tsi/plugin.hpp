@@ -42,6 +42,9 @@ struct TsiPluginLayout {
   /// EIGEN_MAX_ALIGN_BYTES: vectors resized by the plugin are freed by tsi and the other way
   /// round, so both must allocate with the same alignment.
   std::uint32_t eigen_max_align_bytes;
+  /// 1 when compiled with AddressSanitizer: Eigen then allocates through another allocator, and
+  /// memory one side allocates the other frees, so both must agree.
+  std::uint32_t address_sanitizer;
 };
 
 struct TsiPluginInfo {
@@ -78,7 +81,13 @@ constexpr TsiPluginLayout tsi_plugin_layout() {
           layout_of<tsi::Vector>(),
           layout_of<tsi::Json>(),
           layout_of<std::string>(),
-          static_cast<std::uint32_t>(EIGEN_MAX_ALIGN_BYTES)};
+          static_cast<std::uint32_t>(EIGEN_MAX_ALIGN_BYTES),
+#if defined(__SANITIZE_ADDRESS__)
+          1u
+#else
+          0u
+#endif
+  };
 }
 
 /// Name of the entry point the loader looks up.
