@@ -50,7 +50,7 @@
 #include <string>
 
 #include "tsi/error.hpp"
-#include "tsi/fft.hpp"
+#include "tsi/grid_fft.hpp"
 #include "tsi/model.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/plugin.hpp"
@@ -63,26 +63,6 @@ using tsi::Index;
 using tsi::MatrixRef;
 using tsi::Vector;
 
-/// Transforms along x of `columns` states of n_x entries each, all columns in one batched
-/// transform each way (as in the NLS model: tsi::FftBatch transforms along the second index
-/// of a (howmany x n) buffer, so the states are stored transposed, one per row).
-class XBatch {
- public:
-  XBatch(int n_x, Index columns) : fft_(n_x, static_cast<int>(columns)), scratch_(columns, n_x) {}
-
-  /// columns x n_x: row j is state j (grid samples or Fourier coefficients).
-  Eigen::Map<tsi::Matrix> data() { return fft_.data(); }
-  /// Unnormalised: sum_j a_j e^{-2 pi i j k / n_x}.
-  void forward() { fft_.forward_unnormalised(); }
-  /// Unnormalised: sum_k a_k e^{+2 pi i j k / n_x}.
-  void backward() { fft_.backward(); }
-  /// Work space of the same shape (the grid values of the state in a derivative).
-  tsi::Matrix& scratch() { return scratch_; }
-
- private:
-  tsi::FftBatch fft_;
-  tsi::Matrix scratch_;
-};
 
 /// cos and sin of a set of phases.
 struct Phases {
@@ -136,7 +116,7 @@ class KleinGordon final : public tsi::Model {
    private:
     const KleinGordon& model_;
     Phases phases_;
-    XBatch batch_;
+    tsi::GridFft batch_;
   };
 
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
@@ -149,7 +129,7 @@ class KleinGordon final : public tsi::Model {
   // sqrt(2 pi)), and leaves as e^{-i tau} on the way out. Without Rotate, tau = 0 (the field
   // N itself; `phases` is not read). `c` is not written.
   template <bool Rotate>
-  void fused_field(const Phases& phases, XBatch& b, ConstMatrixRef c, MatrixRef out) const {
+  void fused_field(const Phases& phases, tsi::GridFft& b, ConstMatrixRef c, MatrixRef out) const {
     auto w = b.data();  // row j: state j
     const Index cols = c.cols();
     for (Index k = 0; k < n_x_; ++k)
@@ -177,7 +157,7 @@ class KleinGordon final : public tsi::Model {
   void nonlinear_field_derivative(ConstMatrixRef c, ConstMatrixRef d, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
     const Index cols = c.cols();
-    XBatch& b = batch(cols);
+    tsi::GridFft& b = batch(cols);
     tsi::Matrix& grid = b.scratch();
     auto w = b.data();
     for (Index k = 0; k < n_x_; ++k)
@@ -204,7 +184,7 @@ class KleinGordon final : public tsi::Model {
   // (lambda / 4) (2 pi / n_x) sum z_j^4 with z_j = Re backward(a^{-1} c)_j / sqrt(2 pi).
   double H1(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    XBatch& b = batch(1);
+    tsi::GridFft& b = batch(1);
     auto w = b.data();
     w.row(0) = inverse_a_.cwiseProduct(c).transpose();
     b.backward();
@@ -237,7 +217,7 @@ class KleinGordon final : public tsi::Model {
       throw tsi::ConfigError(
           "model.u0", "got " + std::to_string(v.size()) + " samples, expected n_x = " + std::to_string(n_x_));
     std::lock_guard<std::mutex> lock(mutex_);
-    XBatch& b = batch(1);
+    tsi::GridFft& b = batch(1);
     auto w = b.data();
     w.row(0) = v.transpose();
     b.forward();
@@ -247,7 +227,7 @@ class KleinGordon final : public tsi::Model {
   // c -> v = backward(a^{-1} c) / sqrt(2 pi).
   Vector to_physical(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    XBatch& b = batch(1);
+    tsi::GridFft& b = batch(1);
     auto w = b.data();
     w.row(0) = inverse_a_.cwiseProduct(c).transpose();
     b.backward();
@@ -260,9 +240,9 @@ class KleinGordon final : public tsi::Model {
  private:
   // The transforms for batches of `columns` states, planned on first use and kept. Callers
   // hold mutex_.
-  XBatch& batch(Index columns) const {
+  tsi::GridFft& batch(Index columns) const {
     auto it = batches_.find(columns);
-    if (it == batches_.end()) it = batches_.emplace(columns, std::make_unique<XBatch>(n_x_, columns)).first;
+    if (it == batches_.end()) it = batches_.emplace(columns, std::make_unique<tsi::GridFft>(n_x_, columns)).first;
     return *it->second;
   }
 
@@ -276,7 +256,7 @@ class KleinGordon final : public tsi::Model {
   tsi::RealVector inverse_a_;  // a_k^{-1} = (1 + eps k^2)^{-1/4}
   tsi::RealVector remainder_;  // A_k = k^2 / (1 + sqrt(1 + eps k^2))
   mutable std::mutex mutex_;   // the batches' buffers are shared work space
-  mutable std::map<Index, std::unique_ptr<XBatch>> batches_;
+  mutable std::map<Index, std::unique_ptr<tsi::GridFft>> batches_;
 };
 
 void register_klein_gordon(tsi::Registry& registry) {

@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "tsi/error.hpp"
-#include "tsi/fft.hpp"
+#include "tsi/grid_fft.hpp"
 #include "tsi/model.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/plugin.hpp"
@@ -36,27 +36,6 @@ using tsi::Index;
 using tsi::MatrixRef;
 using tsi::Vector;
 
-/// Transforms along x of `columns` states of n_x entries each, all columns in one batched
-/// transform each way. tsi::FftBatch transforms along the second index of a
-/// (howmany x n) buffer, so the states are stored transposed, one per row; its plans are made
-/// once, under the core's FFTW planner lock (runs of a study plan on several threads).
-class XBatch {
- public:
-  XBatch(int n_x, Index columns) : fft_(n_x, static_cast<int>(columns)), scratch_(columns, n_x) {}
-
-  /// columns x n_x: row j is state j (physical samples or Fourier coefficients).
-  Eigen::Map<tsi::Matrix> data() { return fft_.data(); }
-  /// Unnormalised: sum_j a_j e^{-2 pi i j k / n_x}.
-  void forward() { fft_.forward_unnormalised(); }
-  /// Unnormalised: sum_k a_k e^{+2 pi i j k / n_x}.
-  void backward() { fft_.backward(); }
-  /// Work space of the same shape (the second grid of a derivative).
-  tsi::Matrix& scratch() { return scratch_; }
-
- private:
-  tsi::FftBatch fft_;
-  tsi::Matrix scratch_;
-};
 
 class Nls final : public tsi::Model {
  public:
@@ -83,7 +62,7 @@ class Nls final : public tsi::Model {
   // With w = backward(c) = sqrt(2 pi) u:  out = -i forward(|w|^2 w) / (2 pi N_x).
   void nonlinear_field(ConstMatrixRef c, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    XBatch& b = batch(c.cols());
+    tsi::GridFft& b = batch(c.cols());
     auto w = b.data();  // row j: state j
     w = c.transpose();
     b.backward();
@@ -109,7 +88,7 @@ class Nls final : public tsi::Model {
    private:
     const Nls& model_;
     tsi::Matrix phase_;
-    XBatch batch_;
+    tsi::GridFft batch_;
   };
 
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
@@ -119,7 +98,7 @@ class Nls final : public tsi::Model {
   // f_tau in one pass each way: the phases e^{-i m^2 tau} are applied while the states are
   // copied (transposed) into the x-batch, and their conjugates (the flow at -tau) while the
   // result is copied out; the cubic term is written out in real arithmetic (-i a w = (a im, -a re)).
-  void fused_field(const tsi::Matrix& phase, XBatch& b, MatrixRef c, MatrixRef out) const {
+  void fused_field(const tsi::Matrix& phase, tsi::GridFft& b, MatrixRef c, MatrixRef out) const {
     auto w = b.data();  // row j: state j
     const int half = n_x_ / 2;
     for (Index j = 0; j < c.cols(); ++j) {
@@ -150,7 +129,7 @@ class Nls final : public tsi::Model {
   // D(-i |u|^2 u) z = -i (2 |u|^2 z + u^2 conj(z)), on the grid, same scaling as above.
   void nonlinear_field_derivative(ConstMatrixRef c, ConstMatrixRef dc, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    XBatch& b = batch(c.cols());
+    tsi::GridFft& b = batch(c.cols());
     tsi::Matrix& grid = b.scratch();
     auto w = b.data();  // row j: state j
     w = c.transpose();
@@ -178,7 +157,7 @@ class Nls final : public tsi::Model {
   // (1/2) ||u||_{L4}^4 = (pi / N_x) sum |u_j|^4 = sum |w_j|^4 / (4 pi N_x).
   double H1(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    XBatch& b = batch(1);
+    tsi::GridFft& b = batch(1);
     auto w = b.data();
     w.row(0) = c.transpose();
     b.backward();
@@ -216,7 +195,7 @@ class Nls final : public tsi::Model {
   // u' = -i |u|^2 u keeps |u| fixed pointwise: u -> u e^{-i |u|^2 t} on the grid.
   void nonlinear_flow(double t, Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    XBatch& b = batch(1);
+    tsi::GridFft& b = batch(1);
     auto w = b.data();
     w.row(0) = c.transpose();
     b.backward();
@@ -242,7 +221,7 @@ class Nls final : public tsi::Model {
       throw tsi::ConfigError(
           "model.u0", "got " + std::to_string(x.size()) + " samples, expected n_x = " + std::to_string(n_x_));
     std::lock_guard<std::mutex> lock(mutex_);
-    XBatch& b = batch(1);
+    tsi::GridFft& b = batch(1);
     auto w = b.data();
     w.row(0) = x.transpose();
     b.forward();
@@ -252,7 +231,7 @@ class Nls final : public tsi::Model {
   // c -> grid samples u_j = backward(c)_j / sqrt(2 pi).
   Vector to_physical(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    XBatch& b = batch(1);
+    tsi::GridFft& b = batch(1);
     auto w = b.data();
     w.row(0) = c.transpose();
     b.backward();
@@ -266,10 +245,10 @@ class Nls final : public tsi::Model {
   // The transforms for batches of `columns` states, planned on first use and kept: a run
   // sees two or three batch sizes (1 and N_tau), so nothing is planned inside a step after
   // the first call. Callers hold mutex_.
-  XBatch& batch(Index columns) const {
+  tsi::GridFft& batch(Index columns) const {
     auto it = batches_.find(columns);
     if (it == batches_.end())
-      it = batches_.emplace(columns, std::make_unique<XBatch>(n_x_, columns)).first;
+      it = batches_.emplace(columns, std::make_unique<tsi::GridFft>(n_x_, columns)).first;
     return *it->second;
   }
 
@@ -302,7 +281,7 @@ class Nls final : public tsi::Model {
   int n_x_;
   tsi::RealVector wave_numbers_;
   mutable std::mutex mutex_;  // the batches' buffers are shared work space
-  mutable std::map<Index, std::unique_ptr<XBatch>> batches_;
+  mutable std::map<Index, std::unique_ptr<tsi::GridFft>> batches_;
 };
 
 void register_nls(tsi::Registry& registry) {
