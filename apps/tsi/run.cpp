@@ -132,6 +132,17 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
         rconf["initial_data_order"].get<int>()));
   }
 
+  // f_tau of a nonlinearity of degree d has tau harmonics up to |k| = d + 1 (e^{-i tau} times d
+  // factors e^{i tau}); a grid that cannot hold them (n_tau/2 - 1 < d + 1: the Nyquist mode is
+  // dropped) aliases them silently, and the tau monitors see nothing (HH at n_tau = 2: 26% in H).
+  const int degree = assembly.model_entry->nonlinearity_degree;
+  if (rconf.contains("n_tau") && rconf["n_tau"].is_number() && degree > 0 &&
+      rconf["n_tau"].get<long>() / 2 - 1 < degree + 1)
+    result["warnings"].push_back(fmt::format(
+        "reformulation.n_tau = {} cannot hold the tau harmonics of this model's degree-{} nonlinearity "
+        "(up to |k| = {}: n_tau >= {} needed); the result aliases them",
+        rconf["n_tau"].get<long>(), degree, degree + 1, 2 * (degree + 2)));
+
   const double h = config["time"]["h"], t_end = config["time"]["t_end"];
   const long n_steps = step_count(config);
   if (!stream_dir.empty()) {

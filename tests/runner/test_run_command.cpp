@@ -467,3 +467,21 @@ TEST_CASE("run: nls records its momentum P in invariants.csv and result.json, re
   CHECK(std::abs(zero.at("initial").get<double>()) < 1e-15);
   CHECK(zero.at("max_change").get<double>() < 1e-13);
 }
+
+TEST_CASE("run: an n_tau too small for the model's nonlinearity is said, not aliased in silence") {
+  // Henon-Heiles (degree 2): f_tau has harmonics up to |k| = 3, so n_tau >= 8. At n_tau = 2 the
+  // energy is off by 26% while the tau monitors see nothing.
+  for (const int n_tau : {2, 6, 8, 64}) {
+    TempDir dir;
+    Json config = small_config();
+    config["reformulation"] = {{"name", "two-scale"}, {"n_tau", n_tau}};
+    const auto r = run_tsi({"run", write_config(dir, config), "--out", dir / "out"});
+    INFO(r.describe());
+    REQUIRE(r.exit_code == 0);
+    const Json result = read_json(dir.path() / "out" / "result.json");
+    bool warned = false;
+    for (const auto& w : result.at("warnings")) warned = warned || contains(w.get<std::string>(), "tau harmonics");
+    CAPTURE(n_tau);
+    CHECK(warned == (n_tau < 8));
+  }
+}
