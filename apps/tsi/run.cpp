@@ -26,17 +26,56 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// The reference's final state in model variables, with its scheme's tolerance scaled by
-// `tol_factor` and its substeps per fast period by `substep_factor`.
-Vector reference_model_state(const Json& config, const Registry& registry, double tol_factor, double substep_factor) {
-  const Json& ref = config["reference"];
-  const SchemeEntry& scheme = registry.scheme(ref["scheme"], "reference.scheme");
+// The reference's scheme section: its tolerance scaled by `tol_factor`, its substeps per fast
+// period by `substep_factor`.
+Json reference_scheme_section(const Json& ref, const SchemeEntry& scheme, double tol_factor, double substep_factor) {
   Json scheme_section = {{"name", scheme.info.name}};
   for (const auto& spec : scheme.info.params) {
     if (spec.name == "tol") scheme_section["tol"] = std::max(1e-16, ref["tol"].get<double>() * tol_factor);
     if (spec.name == "substeps_per_period")
       scheme_section["substeps_per_period"] = spec.default_value.get<double>() * substep_factor;
   }
+  return scheme_section;
+}
+
+}  // namespace
+
+void check_reference_cost(const Json& config, const Registry& registry) {
+  const Json& ref = config["reference"];
+  const SchemeEntry& scheme = registry.scheme(ref["scheme"], "reference.scheme");
+  const Json scheme_section = reference_scheme_section(ref, scheme, 1.0, 1.0);
+  Assembly a = assemble_config({{"model", config["model"]},
+                                {"reformulation", {{"name", ref["reformulation"]}}},
+                                {"scheme", scheme_section}},
+                               registry);
+  const double t_end = config["time"]["t_end"];
+  // What the reference will cost, refused before it starts when it cannot finish: an adaptive
+  // solver takes at least substeps_per_period steps per fastest period of the problem.
+  constexpr double max_reference_steps = 1e8;  // hours of work for the cheapest solver
+  const double period = a.reformulation->fast_period();
+  if (scheme_section.contains("substeps_per_period") && period > 0.0 &&
+      t_end / period * scheme_section["substeps_per_period"].get<double>() > max_reference_steps)
+    throw ConfigError("reference", fmt::format("{} on the {} problem would take at least {:.3g} steps ({} per fast "
+                                               "period 2 pi eps / {:g}); use a two-scale reference, e.g. "
+                                               "{{\"scheme\": \"se2\", \"reformulation\": \"two-scale\", \"h\": {}}}",
+                                               scheme.info.name, ref["reformulation"].get<std::string>(),
+                                               t_end / period * scheme_section["substeps_per_period"].get<double>(),
+                                               scheme_section["substeps_per_period"].get<double>(),
+                                               a.model->max_linear_frequency(), t_end / 4096));
+  if (!ref["h"].is_null() && t_end / ref["h"].get<double>() > max_reference_steps)
+    throw ConfigError("reference.h", fmt::format("got {}: {:.3g} steps over t_end = {}; at most {:.0e}",
+                                                 ref["h"].get<double>(), t_end / ref["h"].get<double>(), t_end,
+                                                 max_reference_steps));
+}
+
+namespace {
+
+// The reference's final state in model variables, with its scheme's tolerance scaled by
+// `tol_factor` and its substeps per fast period by `substep_factor`.
+Vector reference_model_state(const Json& config, const Registry& registry, double tol_factor, double substep_factor) {
+  const Json& ref = config["reference"];
+  const SchemeEntry& scheme = registry.scheme(ref["scheme"], "reference.scheme");
+  const Json scheme_section = reference_scheme_section(ref, scheme, tol_factor, substep_factor);
   // The same assembler as the run's: a two-scale reference gets the model's own tau
   // resolution and the data its scheme needs.
   Assembly a = assemble_config({{"model", config["model"]},
@@ -77,6 +116,7 @@ ReferenceSolution compute_reference(const Json& config, const Registry& registry
   ReferenceSolution out;
   out.settings = config["reference"];
   const auto start = Clock::now();
+  check_reference_cost(config, registry);
   const Vector u = reference_model_state(config, registry, 1.0, 1.0);
   std::shared_ptr<const Model> model =
       registry.model(config["model"]["name"]).create(Params(without_name(config["model"])));
@@ -117,6 +157,8 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   // Construction: bad input (a model's own checks, u0 of the wrong shape) is a ConfigError
   // that propagates before anything runs.
   Assembly assembly = assemble(config, registry);
+  // A reference that could not finish is refused now, not after the run.
+  if (config.contains("reference") && !shared_reference) check_reference_cost(config, registry);
   const SchemeEntry& scheme_entry = *assembly.scheme_entry;
   std::shared_ptr<const Model> model = assembly.model;
   const Vector u0 = assembly.u0;

@@ -26,6 +26,10 @@ struct ReferenceSolution {
   Json settings;  ///< the resolved reference section
 };
 
+/// Refuses (ConfigError naming reference or reference.h) a reference that would take more
+/// than 1e8 steps: an adaptive solver's fast-period cap times t_end, or t_end / reference.h.
+void check_reference_cost(const Json& resolved, const Registry& registry);
+
 /// Computes the reference solution a resolved config asks for ("reference" section).
 ReferenceSolution compute_reference(const Json& resolved, const Registry& registry);
 
