@@ -5,8 +5,12 @@
 
 #include <atomic>
 #include <cstddef>
+#include <string>
 
 #include "harness.hpp"
+
+// AddressSanitizer owns malloc: interposing it there crashes, so under ASan this file is empty.
+#if !defined(__SANITIZE_ADDRESS__)
 
 namespace {
 std::atomic<long> allocations{0};
@@ -41,31 +45,35 @@ int posix_memalign(void** out, std::size_t alignment, std::size_t size) {
 }
 }
 
-TEST_CASE("a two-scale SE1 step allocates no heap memory once the run is set up") {
+namespace {
+
+// Allocations made by ten SE1 steps on the two-scale problem, after a first step that sizes
+// the scheme's buffers.
+long steady_state_allocations(const std::string& model_name, const tsi::Json& params) {
   auto& h = tsi::test::Harness::instance();
-  auto model = h.model("henon-heiles", 1e-3);
+  auto model = h.model_with(model_name, 1e-3, params);
   auto two_scale = h.reformulation("two-scale", model);
   auto se1 = h.scheme("se1");
   tsi::Vector y = two_scale->prepare(model->initial_value());
-  se1->step(*two_scale, 0.0, 0.125, y);  // the first step sizes the scheme's buffers
+  se1->step(*two_scale, 0.0, 0.125, y);
   const long before = allocations.load();
   for (int n = 1; n <= 10; ++n) se1->step(*two_scale, 0.125 * n, 0.125, y);
-  CHECK(allocations.load() - before == 0);
-  // The counter works: an Eigen vector of this size does allocate.
+  return allocations.load() - before;
+}
+
+}  // namespace
+
+TEST_CASE("a two-scale SE1 step allocates no heap memory once the run is set up") {
+  CHECK(steady_state_allocations("henon-heiles", tsi::Json::object()) == 0);
+  // The counter works: an Eigen vector does allocate.
   const long probe = allocations.load();
-  tsi::Vector copy = y;
+  tsi::Vector copy = tsi::Vector::Zero(64);
   CHECK(allocations.load() - probe >= 1);
-  CHECK(copy.size() == y.size());
+  CHECK(copy.size() == 64);
 }
 
 TEST_CASE("a two-scale SE1 step on Klein-Gordon (x transforms, a linear remainder) allocates no heap memory") {
-  auto& h = tsi::test::Harness::instance();
-  auto model = h.model_with("klein-gordon", 1e-3, {{"n_x", 32}});
-  auto two_scale = h.reformulation("two-scale", model);
-  auto se1 = h.scheme("se1");
-  tsi::Vector y = two_scale->prepare(model->initial_value());
-  se1->step(*two_scale, 0.0, 0.125, y);  // the first step sizes the scheme's buffers
-  const long before = allocations.load();
-  for (int n = 1; n <= 10; ++n) se1->step(*two_scale, 0.125 * n, 0.125, y);
-  CHECK(allocations.load() - before == 0);
+  CHECK(steady_state_allocations("klein-gordon", {{"n_x", 32}}) == 0);
 }
+
+#endif  // !__SANITIZE_ADDRESS__
