@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 
@@ -39,11 +40,18 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
   tsi::app::prepare_output_dir(out_dir);
 
   const bool tty = isatty(fileno(stderr));
+  const auto started = std::chrono::steady_clock::now();
   auto progress = [&](double fraction) {
-    if (tty) fmt::print(stderr, "\r  running: {:5.1f}%", 100.0 * fraction);
+    if (!tty) return;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    if (fraction > 0.0)  // a run of hours says so within its first seconds
+      fmt::print(stderr, "\r  running: {:5.1f}%, {:.0f} s elapsed, about {:.0f} s to go   ", 100.0 * fraction, elapsed,
+                 elapsed * (1.0 - fraction) / fraction);
+    else
+      fmt::print(stderr, "\r  running: {:5.1f}%", 100.0 * fraction);
   };
   const tsi::app::RunOutcome outcome = tsi::app::execute_run(config, registry, progress, nullptr, out_dir);
-  if (tty) fmt::print(stderr, "\r{:30}\r", "");
+  if (tty) fmt::print(stderr, "\r{:80}\r", "");
   tsi::app::write_run_files(out_dir, outcome);
   fmt::print("{}", tsi::app::run_summary(outcome, out_dir));
   if (!outcome.ok) {
