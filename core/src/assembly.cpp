@@ -1,8 +1,12 @@
 #include "tsi/assembly.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <fstream>
+#include <limits>
+#include <string>
 
 #include "tsi/error.hpp"
 
@@ -42,6 +46,36 @@ Json with_name(const std::string& name, const Json& params) {
 bool supports(const SchemeEntry& scheme, const std::string& reformulation) {
   const auto& r = scheme.traits.reformulations;
   return std::find(r.begin(), r.end(), reformulation) != r.end();
+}
+
+// The memory the machine can give a run now (MemAvailable), or its physical memory.
+double available_bytes() {
+  std::ifstream meminfo("/proc/meminfo");
+  for (std::string key; meminfo >> key;) {
+    double kb = 0.0;
+    meminfo >> kb;
+    if (key == "MemAvailable:") return kb * 1024.0;
+    meminfo.ignore(64, '\n');
+  }
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page)
+                               : std::numeric_limits<double>::infinity();
+}
+
+// A two-scale run holds about two dozen vectors of dim x n_tau complex values (the state, a
+// scheme's stages and coefficients, the tau transforms, a spatial model's grid batches):
+// refused before any of them is allocated when that cannot fit.
+void check_footprint(const Model& model, const Json& reformulation) {
+  if (!reformulation.contains("n_tau") || !reformulation["n_tau"].is_number()) return;
+  constexpr double vectors = 24.0, bytes_per_value = 16.0;
+  const double n_tau = reformulation["n_tau"].get<double>(), dim = static_cast<double>(model.dim());
+  const double needed = vectors * bytes_per_value * dim * n_tau, available = available_bytes();
+  if (needed > available)
+    throw ConfigError("reformulation.n_tau",
+                      fmt::format("got {:.0f}: with the model's {:.0f} unknowns a run needs about {:.3g} GB "
+                                  "({:.0f} x {:.0f} complex values, two dozen times), and this machine has "
+                                  "{:.3g} GB available",
+                                  n_tau, dim, needed / 1e9, dim, n_tau, available / 1e9));
 }
 
 }  // namespace
@@ -102,6 +136,7 @@ Assembly assemble(const Json& resolved, const Registry& registry) {
   a.scheme_entry = &registry.scheme(resolved.at("scheme").at("name"));
   a.model = a.model_entry->create(Params(without_name(resolved["model"])));
   a.u0 = initial_value(*a.model, resolved["model"]);
+  check_footprint(*a.model, resolved["reformulation"]);
   a.reformulation = a.reformulation_entry->create(a.model, Params(without_name(resolved["reformulation"])));
   const StepperTraits& traits = a.scheme_entry->traits;
   const std::string pair = fmt::format("model \"{}\" on the \"{}\" reformulation", a.model_entry->info.name,
