@@ -40,17 +40,22 @@ Json reference_scheme_section(const Json& ref, const SchemeEntry& scheme, double
 
 }  // namespace
 
-void check_reference_cost(const Json& config, const Registry& registry) {
+namespace {
+
+// The reference's objects, through the same assembler as the run's (a two-scale reference gets
+// the model's own tau resolution and the data its scheme needs).
+Assembly reference_assembly(const Json& config, const Registry& registry, const Json& scheme_section) {
+  return assemble_config({{"model", config["model"]},
+                          {"reformulation", {{"name", config["reference"]["reformulation"]}}},
+                          {"scheme", scheme_section}},
+                         registry);
+}
+
+// What the reference will cost, refused before it starts when it cannot finish: an adaptive
+// solver takes at least substeps_per_period steps per fastest period of the problem.
+void check_reference_cost(const Json& config, const Assembly& a, const Json& scheme_section) {
   const Json& ref = config["reference"];
-  const SchemeEntry& scheme = registry.scheme(ref["scheme"], "reference.scheme");
-  const Json scheme_section = reference_scheme_section(ref, scheme, 1.0, 1.0);
-  Assembly a = assemble_config({{"model", config["model"]},
-                                {"reformulation", {{"name", ref["reformulation"]}}},
-                                {"scheme", scheme_section}},
-                               registry);
   const double t_end = config["time"]["t_end"];
-  // What the reference will cost, refused before it starts when it cannot finish: an adaptive
-  // solver takes at least substeps_per_period steps per fastest period of the problem.
   constexpr double max_reference_steps = 1e8;  // hours of work for the cheapest solver
   const double period = a.reformulation->fast_period();
   if (scheme_section.contains("substeps_per_period") && period > 0.0 &&
@@ -58,7 +63,7 @@ void check_reference_cost(const Json& config, const Registry& registry) {
     throw ConfigError("reference", fmt::format("{} on the {} problem would take at least {:.3g} steps ({} per fast "
                                                "period 2 pi eps / {:g}); use a two-scale reference, e.g. "
                                                "{{\"scheme\": \"se2\", \"reformulation\": \"two-scale\", \"h\": {}}}",
-                                               scheme.info.name, ref["reformulation"].get<std::string>(),
+                                               a.scheme_entry->info.name, ref["reformulation"].get<std::string>(),
                                                t_end / period * scheme_section["substeps_per_period"].get<double>(),
                                                scheme_section["substeps_per_period"].get<double>(),
                                                a.model->max_linear_frequency(), t_end / 4096));
@@ -66,6 +71,15 @@ void check_reference_cost(const Json& config, const Registry& registry) {
     throw ConfigError("reference.h", fmt::format("got {}: {:.3g} steps over t_end = {}; at most {:.0e}",
                                                  ref["h"].get<double>(), t_end / ref["h"].get<double>(), t_end,
                                                  max_reference_steps));
+}
+
+}  // namespace
+
+void check_reference_cost(const Json& config, const Registry& registry) {
+  const Json& ref = config["reference"];
+  const Json scheme_section =
+      reference_scheme_section(ref, registry.scheme(ref["scheme"], "reference.scheme"), 1.0, 1.0);
+  check_reference_cost(config, reference_assembly(config, registry, scheme_section), scheme_section);
 }
 
 namespace {
@@ -76,12 +90,8 @@ Vector reference_model_state(const Json& config, const Registry& registry, doubl
   const Json& ref = config["reference"];
   const SchemeEntry& scheme = registry.scheme(ref["scheme"], "reference.scheme");
   const Json scheme_section = reference_scheme_section(ref, scheme, tol_factor, substep_factor);
-  // The same assembler as the run's: a two-scale reference gets the model's own tau
-  // resolution and the data its scheme needs.
-  Assembly a = assemble_config({{"model", config["model"]},
-                                {"reformulation", {{"name", ref["reformulation"]}}},
-                                {"scheme", scheme_section}},
-                               registry);
+  Assembly a = reference_assembly(config, registry, scheme_section);
+  if (tol_factor == 1.0 && substep_factor == 1.0) check_reference_cost(config, a, scheme_section);
   const double t_end = config["time"]["t_end"];
   Vector y = a.reformulation->prepare(a.u0);
   if (t_end > 0.0) {
@@ -116,8 +126,7 @@ ReferenceSolution compute_reference(const Json& config, const Registry& registry
   ReferenceSolution out;
   out.settings = config["reference"];
   const auto start = Clock::now();
-  check_reference_cost(config, registry);
-  const Vector u = reference_model_state(config, registry, 1.0, 1.0);
+  const Vector u = reference_model_state(config, registry, 1.0, 1.0);  // its cost checked first
   std::shared_ptr<const Model> model =
       registry.model(config["model"]["name"]).create(Params(without_name(config["model"])));
   out.x = model->to_physical(u);

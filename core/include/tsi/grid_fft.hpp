@@ -1,4 +1,7 @@
 #pragma once
+#include <map>
+#include <memory>
+
 #include "tsi/fft.hpp"
 #include "tsi/types.hpp"
 
@@ -26,6 +29,23 @@ class GridFft {
  private:
   FftBatch fft_;
   Matrix scratch_;
+};
+
+/// GridFft for every batch size a model meets, planned on first use and kept: a run sees two
+/// or three sizes (1 and n_tau), so nothing is planned inside a step after the first call. Not
+/// synchronised: the model serialises its calls (its buffers are shared work space).
+class GridFftPool {
+ public:
+  explicit GridFftPool(int n) : n_(n) {}
+  GridFft& get(Index columns) {
+    auto it = batches_.find(columns);
+    if (it == batches_.end()) it = batches_.emplace(columns, std::make_unique<GridFft>(n_, columns)).first;
+    return *it->second;
+  }
+
+ private:
+  int n_;
+  std::map<Index, std::unique_ptr<GridFft>> batches_;
 };
 
 }  // namespace tsi

@@ -44,7 +44,6 @@
 // in eps: e^2 z_t(0) = (1 - e^2 d_xx)^{1/2} of an eps-independent smooth function is O(1).
 #include <cmath>
 #include <complex>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -74,7 +73,7 @@ struct Phases {
 class KleinGordon final : public tsi::Model {
  public:
   KleinGordon(double eps, int n_x, double lambda)
-      : Model(eps), n_x_(n_x), lambda_(lambda), inverse_a_(n_x), remainder_(n_x) {
+      : Model(eps), n_x_(n_x), lambda_(lambda), inverse_a_(n_x), remainder_(n_x), batches_(n_x) {
     for (int j = 0; j < n_x; ++j) {
       const double k = 2 * j <= n_x ? j : j - n_x;  // the Nyquist index as k = n_x / 2
       const double root = std::sqrt(1.0 + eps * k * k);
@@ -240,11 +239,7 @@ class KleinGordon final : public tsi::Model {
  private:
   // The transforms for batches of `columns` states, planned on first use and kept. Callers
   // hold mutex_.
-  tsi::GridFft& batch(Index columns) const {
-    auto it = batches_.find(columns);
-    if (it == batches_.end()) it = batches_.emplace(columns, std::make_unique<tsi::GridFft>(n_x_, columns)).first;
-    return *it->second;
-  }
+  tsi::GridFft& batch(Index columns) const { return batches_.get(columns); }
 
   // a b, written out: std::complex's operator* tests every product for inf/NaN.
   static Complex times(Complex a, Complex b) {
@@ -256,7 +251,7 @@ class KleinGordon final : public tsi::Model {
   tsi::RealVector inverse_a_;  // a_k^{-1} = (1 + eps k^2)^{-1/4}
   tsi::RealVector remainder_;  // A_k = k^2 / (1 + sqrt(1 + eps k^2))
   mutable std::mutex mutex_;   // the batches' buffers are shared work space
-  mutable std::map<Index, std::unique_ptr<tsi::GridFft>> batches_;
+  mutable tsi::GridFftPool batches_;
 };
 
 void register_klein_gordon(tsi::Registry& registry) {

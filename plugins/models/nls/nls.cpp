@@ -16,7 +16,6 @@
 // sqrt(2 pi / N_x) |u|.
 #include <cmath>
 #include <complex>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -39,7 +38,7 @@ using tsi::Vector;
 
 class Nls final : public tsi::Model {
  public:
-  Nls(double eps, int n_x) : Model(eps), n_x_(n_x), wave_numbers_(n_x) {
+  Nls(double eps, int n_x) : Model(eps), n_x_(n_x), wave_numbers_(n_x), batches_(n_x) {
     for (int k = 0; k < n_x; ++k) wave_numbers_(k) = 2 * k < n_x ? k : k - n_x;
     batch(1);  // the single-state plans (filtered, direct, invariants)
   }
@@ -245,12 +244,7 @@ class Nls final : public tsi::Model {
   // The transforms for batches of `columns` states, planned on first use and kept: a run
   // sees two or three batch sizes (1 and N_tau), so nothing is planned inside a step after
   // the first call. Callers hold mutex_.
-  tsi::GridFft& batch(Index columns) const {
-    auto it = batches_.find(columns);
-    if (it == batches_.end())
-      it = batches_.emplace(columns, std::make_unique<tsi::GridFft>(n_x_, columns)).first;
-    return *it->second;
-  }
+  tsi::GridFft& batch(Index columns) const { return batches_.get(columns); }
 
   // e^{-i m^2 tau_j} for m = 0 .. N_x/2 (rows) and every tau_j (columns), by the recurrence
   // e^{-i (m+1)^2 tau} = e^{-i m^2 tau} e^{-i (2m+1) tau}: one sincos per column, rounding of
@@ -281,7 +275,7 @@ class Nls final : public tsi::Model {
   int n_x_;
   tsi::RealVector wave_numbers_;
   mutable std::mutex mutex_;  // the batches' buffers are shared work space
-  mutable std::map<Index, std::unique_ptr<tsi::GridFft>> batches_;
+  mutable tsi::GridFftPool batches_;
 };
 
 void register_nls(tsi::Registry& registry) {
