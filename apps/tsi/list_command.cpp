@@ -52,8 +52,9 @@ Json list_json(const Registry& registry, const std::string& what) {
     out["schemes"] = Json::array();
     for (const auto* e : registry.schemes()) {
       Json j = info_json(e->info);
-      const auto& t = e->traits;
-      j["traits"] = {{"order", t.order},         {"symmetric", t.symmetric},
+      const StepperTraits t = default_traits(*e);  // with its default parameters
+      j["traits"] = {{"order", t.order},         {"classical_order", std::max(t.order, t.classical_order)},
+                     {"symmetric", t.symmetric},
                      {"implicit", t.implicit},   {"multistep", t.multistep},
                      {"adaptive", t.adaptive},   {"initial_data_order", t.initial_data_order},
                      {"reformulations", t.reformulations}};
@@ -78,7 +79,9 @@ std::string list_text(const Registry& registry, const std::string& what) {
         const auto& t = e["traits"];
         std::string reforms;
         for (const auto& r : t["reformulations"]) reforms += (reforms.empty() ? "" : ", ") + r.get<std::string>();
-        s += fmt::format("      order {}, {}, {}, data order {}, on: {}\n", t["order"].get<int>(),
+        const int classical = t["classical_order"].get<int>();
+        s += fmt::format("      order {}{}, {}, {}, data order {}, on: {}\n", t["order"].get<int>(),
+                         classical > t["order"].get<int>() ? fmt::format(" uniformly ({} at fixed eps)", classical) : "",
                          t["symmetric"].get<bool>() ? "symmetric" : "not symmetric",
                          t["implicit"].get<bool>() ? "implicit" : "explicit",
                          t["initial_data_order"].get<int>(), reforms);

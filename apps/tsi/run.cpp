@@ -176,10 +176,10 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
 
   const auto& rconf = config["reformulation"];
   if (rconf.contains("initial_data_order") &&
-      rconf["initial_data_order"].get<int>() < scheme_entry.traits.initial_data_order) {
+      rconf["initial_data_order"].get<int>() < assembly.traits.initial_data_order) {
     result["warnings"].push_back(fmt::format(
         "scheme \"{}\" needs prepared data of order {} for uniform accuracy; running with order {}",
-        scheme_entry.info.name, scheme_entry.traits.initial_data_order,
+        scheme_entry.info.name, assembly.traits.initial_data_order,
         rconf["initial_data_order"].get<int>()));
   }
 
@@ -207,6 +207,15 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   auto last_progress = Clock::now();
   try {
     Vector y = reformulation->prepare(u0);
+    const int data_order = reformulation->data_order_reached();
+    if (data_order > 0) {
+      result["initial_data_order_reached"] = data_order;
+      if (rconf.contains("initial_data_order") && data_order < rconf["initial_data_order"].get<int>())
+        result["warnings"].push_back(fmt::format(
+            "prepared data reached order {} of the {} asked: the recursion's corrections stopped decreasing "
+            "(eps = {:g} is too large for its asymptotic expansion beyond that order)",
+            data_order, rconf["initial_data_order"].get<int>(), model->eps()));
+    }
     integrate(*reformulation, *stepper, y, h, n_steps, [&](long n, double t, const Vector& state) {
       const bool go_on = recorder.observe(n, t, state);
       if (go_on && interrupted()) {  // kept up to this step, and written as "interrupted"

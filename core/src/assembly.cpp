@@ -95,12 +95,13 @@ Json resolve_selection(const Json& config, const Registry& registry) {
       registry.reformulation(name_of(reformulation, "reformulation", default_reformulation));
   registry.check_compatible(scheme_entry, reformulation_entry);
 
-  const Selection selection{model_entry, reformulation_entry, scheme_entry};
+  Selection selection{model_entry, reformulation_entry, scheme_entry};
   Json model_params = resolve_params(model_entry.info.params, without_name(model), "model");
   Json scheme_params = resolve_params(scheme_entry.info.params, without_name(scheme), "scheme");
   Json reformulation_params =
       resolve_params(reformulation_entry.info.params, without_name(reformulation), "reformulation");
   if (scheme_entry.complete) scheme_entry.complete(scheme_params, selection);
+  selection.scheme_params = &scheme_params;
   if (reformulation_entry.complete) reformulation_entry.complete(reformulation_params, selection);
   return {{"model", with_name(model_entry.info.name, model_params)},
           {"reformulation", with_name(reformulation_entry.info.name, reformulation_params)},
@@ -138,7 +139,8 @@ Assembly assemble(const Json& resolved, const Registry& registry) {
   a.u0 = initial_value(*a.model, resolved["model"]);
   check_footprint(*a.model, resolved["reformulation"]);
   a.reformulation = a.reformulation_entry->create(a.model, Params(without_name(resolved["reformulation"])));
-  const StepperTraits& traits = a.scheme_entry->traits;
+  a.traits = scheme_traits(*a.scheme_entry, without_name(resolved["scheme"]));
+  const StepperTraits& traits = a.traits;
   const std::string pair = fmt::format("model \"{}\" on the \"{}\" reformulation", a.model_entry->info.name,
                                        a.reformulation_entry->info.name);
   if (traits.needs_diagonal_linear_part && !a.reformulation->has_diagonal_linear_part())

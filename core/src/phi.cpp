@@ -1,7 +1,10 @@
 #include "tsi/phi.hpp"
 
 #include <array>
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace tsi {
 namespace {
@@ -47,6 +50,33 @@ Complex phi1(Complex z) {
 Complex phi2(Complex z) {
   if (std::abs(z) <= series_radius) return series(z, 2);
   return (expm1(z) - z) / (z * z);
+}
+
+Complex phi(int k, Complex z) {
+  if (k < 0 || k > 20) throw std::invalid_argument("tsi::phi: k = " + std::to_string(k) + ", expected 0 to 20");
+  if (k == 0) return std::exp(z);
+  const double r = std::abs(z);
+  if (r <= std::max(1.0, static_cast<double>(k))) {
+    // Terms |z|^m / (m + k)! with |z| <= k fall below 2^-60 of the first within 60 terms
+    // (at k = 20: 20^60 / 80! ~ 1e-41); the sum of their moduli is within a factor 10 of
+    // |phi_k| there, so no digits cancel.
+    constexpr int terms = 64;
+    double inv = 1.0;  // 1 / (terms + k)!
+    for (int n = 2; n <= terms + k; ++n) inv /= n;
+    Complex sum = 0.0;
+    for (int m = terms; m >= 0; --m) {
+      sum = sum * z + inv;
+      inv *= (m + k);  // 1/(m + k - 1)!
+    }
+    return sum;
+  }
+  Complex value = phi1(z);
+  double inv_factorial = 1.0;  // 1/j!
+  for (int j = 1; j < k; ++j) {
+    inv_factorial /= j;
+    value = (value - inv_factorial) / z;
+  }
+  return value;
 }
 
 }  // namespace tsi

@@ -25,10 +25,14 @@ void register_core(Registry& registry) {
            .check([](const Json& v) { return v.get<long>() > 0 && v.get<long>() <= (1L << 20) && v.get<long>() % 2 == 0; },
                   "an even integer from 2 to 1048576"),
        integer_param("initial_data_order", nullptr,
-                     "order of the prepared initial data (1, 2 or 3); default: what the scheme "
-                     "needs for uniform second order")
-           .check([](const Json& v) { return v.get<long>() >= 1 && v.get<long>() <= 3; },
-                  "1, 2 or 3"),
+                     "order of the prepared initial data (1 to 8); default: what the scheme "
+                     "needs for its uniform order")
+           .check([](const Json& v) { return v.get<long>() >= 1 && v.get<long>() <= TwoScale::max_data_order; },
+                  "an integer from 1 to 8"),
+       string_param("initial_data_method", "auto",
+                    "auto: SPEC.md's closed formulas for orders 1-3, the derivative-free recursion above; "
+                    "recursion: the recursion at every order")
+           .check([](const Json& v) { return v == "auto" || v == "recursion"; }, "auto or recursion"),
        integer_or_string_param("reprepare", "never",
                                "re-prepare U from the solution (SPEC.md section 6): never (the paper's "
                                "schemes), every K steps (an integer), or auto (when tau_spread grows)")
@@ -48,7 +52,11 @@ void register_core(Registry& registry) {
       ""};
   two_scale.complete = [](Json& p, const Selection& s) {
     if (p["n_tau"].is_null()) p["n_tau"] = s.model.default_n_tau;
-    if (p["initial_data_order"].is_null()) p["initial_data_order"] = std::max(1, s.scheme.traits.initial_data_order);
+    if (p["initial_data_order"].is_null()) {
+      const StepperTraits traits =
+          s.scheme_params ? scheme_traits(s.scheme, *s.scheme_params) : s.scheme.traits;
+      p["initial_data_order"] = std::max(1, traits.initial_data_order);
+    }
   };
   two_scale.create = [](std::shared_ptr<const Model> model, const Params& p) {
     const int n_tau = p.has("n_tau") ? static_cast<int>(p.integer("n_tau")) : 64;
@@ -64,7 +72,8 @@ void register_core(Registry& registry) {
     }
     if (p.has("reprepare_defect")) repreparation.defect = p.number("reprepare_defect");
     if (p.has("reprepare_min_gap")) repreparation.min_gap = p.integer("reprepare_min_gap");
-    return std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation);
+    const bool recursion = p.has("initial_data_method") && p.string("initial_data_method") == "recursion";
+    return std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation, recursion);
   };
   registry.add_reformulation(std::move(two_scale));
 

@@ -172,3 +172,15 @@ void Registry::remove_provider(const std::string& provider) {
 }
 
 }  // namespace tsi
+
+namespace tsi {
+
+StepperTraits scheme_traits(const SchemeEntry& scheme, const Json& params) {
+  return scheme.traits_for ? scheme.traits_for(params) : scheme.traits;
+}
+
+StepperTraits default_traits(const SchemeEntry& scheme) {
+  return scheme_traits(scheme, resolve_params(scheme.info.params, Json::object(), "scheme"));
+}
+
+}  // namespace tsi

@@ -10,6 +10,7 @@
 #include <string>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "harness.hpp"
 #include "tsi/model_checks.hpp"
@@ -26,10 +27,10 @@ double error_at_one(const tsi::SchemeEntry& scheme, double eps, long steps) {
   auto& h = Harness::instance();
   auto model = h.model("henon-heiles", eps);
   auto two_scale = h.reformulation("two-scale", model,
-                                   {{"n_tau", 64}, {"initial_data_order", std::max(1, scheme.traits.initial_data_order)}});
+                                   {{"n_tau", 64}, {"initial_data_order", std::max(1, tsi::default_traits(scheme).initial_data_order)}});
   tsi::Json params = tsi::Json::object();
   for (const auto& p : scheme.info.params)
-    if (p.name == "tol") params["tol"] = 1e-12;
+    if (p.name == "tol") params["tol"] = 1e-14;  // below the errors of order 4 at h = 1/128
   auto stepper = h.scheme(scheme.info.name, params, "henon-heiles");
   const Vector& ref = tsi::test::reference_solution("henon-heiles", eps, 1.0);
   return (tsi::test::solve(*model, *two_scale, *stepper, 1.0, steps) - ref).norm() / ref.norm();
@@ -44,29 +45,50 @@ TEST_CASE("conformance: the two-scale schemes include the paper's four") {
     CHECK(std::find(names.begin(), names.end(), expected) != names.end());
 }
 
-TEST_CASE("conformance: every two-scale scheme is uniformly second order on Henon-Heiles") {
+TEST_CASE("conformance: every two-scale scheme reaches its declared uniform order on Henon-Heiles") {
+  // Per eps, a least-squares order within 0.3 of the declared one (0.15 at order 2) and the
+  // error at each h within 2x of eps = 1 (1.5x at order 2); a scheme whose classical order
+  // exceeds its uniform order is held to the bound C h^p on the maximum over eps instead.
   const std::vector<double> epsilons = {1.0, 1.0 / 16, 1.0 / 256, 1.0 / 4096, 1e-6};
-  const std::vector<long> steps = {4, 8, 16, 32, 64};  // h = 1/4 .. 1/64
-  std::vector<double> hs;
-  for (long n : steps) hs.push_back(1.0 / static_cast<double>(n));
+  constexpr double reference_floor = 1e-10;  // the rk78 reference's own accuracy at small eps
   for (const auto* scheme : two_scale_schemes()) {
+    const tsi::StepperTraits traits = tsi::default_traits(*scheme);
+    const bool envelope = traits.classical_order > traits.order;
+    // h = 1/8 .. 1/128; the high-order maxima reach the reference's accuracy from h = 1/32
+    const std::vector<long> steps = envelope ? std::vector<long>{2, 4, 8, 16, 32} : std::vector<long>{8, 16, 32, 64, 128};
+    std::vector<double> hs;
+    for (long n : steps) hs.push_back(1.0 / static_cast<double>(n));
     std::vector<std::vector<double>> errors;
     for (double eps : epsilons) {
       errors.emplace_back();
       for (long n : steps) errors.back().push_back(error_at_one(*scheme, eps, n));
     }
     CAPTURE(scheme->info.name);
+    CAPTURE(traits.order);
+    if (envelope) {
+      std::vector<double> worst(hs.size(), 0.0);
+      for (const auto& e : errors)
+        for (size_t i = 0; i < hs.size(); ++i) worst[i] = std::max(worst[i], e[i]);
+      const tsi::OrderFit fit = tsi::fit_order(hs, worst, reference_floor);
+      CAPTURE(fmt::format("{:.2e}", fmt::join(worst, " ")));
+      REQUIRE(fit.measurable);
+      CHECK(fit.order >= traits.order - 0.3);
+      continue;
+    }
+    const double margin = traits.order == 2 ? 0.15 : 0.3, spread = traits.order == 2 ? 1.5 : 2.0;
     for (size_t k = 0; k < epsilons.size(); ++k) {
-      const double order = tsi::least_squares_order(hs, errors[k]);
+      const tsi::OrderFit fit = tsi::fit_order(hs, errors[k], reference_floor);
       CAPTURE(epsilons[k]);
-      CAPTURE(order);
-      CHECK(std::abs(order - 2.0) <= 0.15);
+      CAPTURE(fmt::format("{:.2e}", fmt::join(errors[k], " ")));
+      CAPTURE(fit.order);
+      REQUIRE(fit.measurable);
+      CHECK(std::abs(fit.order - traits.order) <= margin);
     }
     for (size_t i = 0; i < hs.size(); ++i) {
       double largest = 0.0;
       for (const auto& e : errors) largest = std::max(largest, e[i]);
       CAPTURE(hs[i]);
-      CHECK(largest <= 1.5 * errors[0][i]);  // max over eps within 1.5x of eps = 1
+      CHECK(largest <= spread * std::max(errors[0][i], reference_floor));  // max over eps vs eps = 1
     }
   }
 }
@@ -106,7 +128,7 @@ TEST_CASE("conformance: a step h then -h returns the state exactly when the sche
         CAPTURE(scheme->info.name);
         CAPTURE(eps);
         CAPTURE(back);
-        if (scheme->traits.symmetric)
+        if (tsi::default_traits(*scheme).symmetric)
           CHECK(back <= 1e-12);
         else
           CHECK(back > 1e-8);  // would fail if the scheme became symmetric
@@ -132,11 +154,19 @@ TEST_CASE("conformance: every model with every two-scale scheme, in the model's 
     CAPTURE(table);
     CHECK(report.failures.empty());
     CHECK(report.count > 0);
-    for (const auto* scheme : two_scale_schemes())
+    for (const auto* scheme : two_scale_schemes()) {
+      const tsi::StepperTraits traits = tsi::default_traits(*scheme);
+      if (traits.classical_order > traits.order) {  // one row: the maximum over eps
+        const std::string row = fmt::format("ok    {:<12} {:<10}", scheme->info.name, "max");
+        CAPTURE(row);
+        CHECK(table.find(row) != std::string::npos);
+        continue;
+      }
       for (const double eps : model->verification.epsilons) {
         const std::string row = fmt::format("ok    {:<12} {:<10.4g}", scheme->info.name, eps);
         CAPTURE(row);
         CHECK(table.find(row) != std::string::npos);
       }
+    }
   }
 }

@@ -75,14 +75,14 @@ Vector rotating_frame_long_double(double eps_in, double t_end) {
 double relative(const Vector& x, const Vector& ref) { return (x - ref).norm() / ref.norm(); }
 
 // FD's third-order data is rougher in tau: N_tau = 128 for it (SPEC.md section 4).
-int n_tau_for(const tsi::SchemeEntry& scheme) { return scheme.traits.initial_data_order >= 3 ? 128 : 64; }
+int n_tau_for(const tsi::SchemeEntry& scheme) { return tsi::default_traits(scheme).initial_data_order >= 3 ? 128 : 64; }
 
 double cpd_error(const tsi::SchemeEntry& scheme, double eps, long steps) {
   auto& h = Harness::instance();
   auto model = h.model("cpd", eps);
   auto two_scale = h.reformulation(
       "two-scale", model,
-      {{"n_tau", n_tau_for(scheme)}, {"initial_data_order", std::max(1, scheme.traits.initial_data_order)}});
+      {{"n_tau", n_tau_for(scheme)}, {"initial_data_order", std::max(1, tsi::default_traits(scheme).initial_data_order)}});
   tsi::Json params = tsi::Json::object();
   for (const auto& p : scheme.info.params)
     if (p.name == "tol") params["tol"] = 1e-12;
@@ -218,7 +218,7 @@ TEST_CASE("cpd: at eps = 1e-5 the reference agrees with a long-double integratio
 
 TEST_CASE("cpd: second order at eps = 1 for every two-scale scheme") {
   std::vector<std::string> names;
-  for (const auto* scheme : tsi::test::two_scale_schemes()) {
+  for (const auto* scheme : tsi::test::second_order_schemes()) {
     names.push_back(scheme->info.name);
     // The asymptotic range h = 1/16 .. 1/128. (From h = 1/4, FD and ME are still
     // pre-asymptotic at eps = 1: their successive orders rise 1.5, 1.8, 2.0 and
@@ -240,7 +240,7 @@ TEST_CASE("cpd: second order at eps = 1 for every two-scale scheme") {
 
 TEST_CASE("cpd: at every h the error of every two-scale scheme falls as eps falls") {
   // The dynamics become trivial at leading order as eps -> 0 (SPEC.md section 5.1).
-  for (const auto* scheme : tsi::test::two_scale_schemes()) {
+  for (const auto* scheme : tsi::test::second_order_schemes()) {
     for (long n : {4, 8, 16, 32}) {
       const double e1 = cpd_error(*scheme, 1.0, n), e16 = cpd_error(*scheme, 1.0 / 16, n),
                    e256 = cpd_error(*scheme, 1.0 / 256, n);
@@ -264,7 +264,7 @@ TEST_CASE("cpd: over T = 200 at eps = 0.5, SE1 keeps the energy error small whil
   auto max_energy_error = [&](const std::string& name) {
     const auto& entry = h.registry().scheme(name);
     auto two_scale = h.reformulation(
-        "two-scale", model, {{"n_tau", 64}, {"initial_data_order", entry.traits.initial_data_order}});
+        "two-scale", model, {{"n_tau", 64}, {"initial_data_order", tsi::default_traits(entry).initial_data_order}});
     auto stepper = h.scheme(name, tsi::Json::object(), "cpd");
     Vector y = two_scale->prepare(u0);
     double err_H = 0.0;

@@ -64,7 +64,7 @@ TEST_CASE("re-preparation: uniform second order at T = 1 is kept, every step and
   const std::vector<long> steps = {4, 8, 16, 32};
   std::vector<double> hs;
   for (long n : steps) hs.push_back(1.0 / static_cast<double>(n));
-  for (const auto* scheme : tsi::test::two_scale_schemes())
+  for (const auto* scheme : tsi::test::second_order_schemes())
     for (double eps : {1.0, 1.0 / 256, 1.0 / 4096})
       for (const Json& rule : {Json(1), Json("auto")}) {
         std::vector<double> plain, reprepared;
@@ -115,7 +115,7 @@ TEST_CASE("re-preparation: every model keeps its order at T = 1 in its declared 
     const auto& regime = Harness::instance().registry().model(model).verification;
     std::vector<double> hs;
     for (long n : regime.steps) hs.push_back(1.0 / static_cast<double>(n));
-    for (const auto* scheme : tsi::test::two_scale_schemes())
+    for (const auto* scheme : tsi::test::second_order_schemes())
       for (const double eps : regime.epsilons)
         for (const Json& rule : {Json(1), Json("auto")}) {
           std::vector<double> plain, reprepared;

@@ -153,9 +153,9 @@ TEST_CASE("run errors: eps too small for 1/eps to be a double") {
   check_bad_input(run_example_with({"model.eps=5e-324"}), "model.eps", {"at least 1e-300"});
 }
 
-TEST_CASE("run errors: initial_data_order must be 1 2 or 3") {
-  check_bad_input(run_example_with({"reformulation.initial_data_order=4"}), "reformulation.initial_data_order",
-                  {"got 4", "1, 2 or 3"});
+TEST_CASE("run errors: initial_data_order must be from 1 to 8") {
+  check_bad_input(run_example_with({"reformulation.initial_data_order=9"}), "reformulation.initial_data_order",
+                  {"got 9", "from 1 to 8"});
 }
 
 TEST_CASE("run errors: scheme parameters are checked") {

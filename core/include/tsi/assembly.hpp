@@ -21,6 +21,7 @@ struct TSI_API Assembly {
   const ModelEntry* model_entry = nullptr;
   const ReformulationEntry* reformulation_entry = nullptr;
   const SchemeEntry* scheme_entry = nullptr;
+  StepperTraits traits;  ///< the scheme's traits with its resolved parameters (scheme_traits)
   std::shared_ptr<const Model> model;
   std::unique_ptr<Reformulation> reformulation;
   std::unique_ptr<Stepper> stepper;

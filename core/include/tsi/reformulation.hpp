@@ -26,6 +26,9 @@ class TSI_API Reformulation : public Problem {
   virtual double tau_spread(const Vector& /*y*/) const { return 0.0; }
   /// The times t_n at which the state was re-prepared (two-scale; empty otherwise).
   virtual std::vector<double> repreparation_times() const { return {}; }
+  /// The order of the prepared data of the last prepare() (two-scale; 0 otherwise): below the
+  /// configured order when the asymptotic recursion stopped at its smallest correction.
+  virtual int data_order_reached() const { return 0; }
 
   const Model& model() const { return *model_; }
 

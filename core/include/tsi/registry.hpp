@@ -36,12 +36,19 @@ struct TSI_API Selection {
   const ModelEntry& model;
   const ReformulationEntry& reformulation;
   const SchemeEntry& scheme;
+  /// The scheme's resolved and completed parameters, set when the reformulation is completed
+  /// (a two-scale data order follows the scheme's traits, which may depend on them).
+  const Json* scheme_params = nullptr;
 };
 
 /// Completes an entry's resolved parameters from the selection: sets the ones its schema left
 /// null (optional, no fixed default) to what this model and scheme need. Runs after the
 /// schema check, before anything is built.
 using CompleteFn = std::function<void(Json& params, const Selection& selection)>;
+
+/// The traits of a scheme whose order or needs follow from its parameters (a composition's
+/// method and base, an Adams-Bashforth order), from its resolved parameters.
+using TraitsFn = std::function<StepperTraits(const Json& params)>;
 
 /// Where a model's order is observable at T = 1 from its default u0: `tsi check`'s defaults
 /// and the regime of the conformance suite, which runs every scheme there.
@@ -71,7 +78,14 @@ struct TSI_API SchemeEntry {
   StepperTraits traits;
   StepperFactory create;
   CompleteFn complete;  ///< optional (SE2: quadrature nodes from the model's nonlinearity)
+  TraitsFn traits_for;  ///< optional: traits that depend on the parameters (else `traits`)
 };
+
+/// What a scheme is with these resolved parameters: traits_for(params) when the scheme has
+/// one, else its declared traits.
+TSI_API StepperTraits scheme_traits(const SchemeEntry& scheme, const Json& params);
+/// The same for the scheme's default parameters (what `tsi list` and `tsi check` show).
+TSI_API StepperTraits default_traits(const SchemeEntry& scheme);
 
 /// The runtime registry of models, reformulations and schemes (PETSc TSRegister / OpenFOAM
 /// runtime selection). Look-ups accept names and aliases; a miss lists the valid names.

@@ -10,7 +10,12 @@ namespace tsi {
 /// What a scheme is and what it needs from the problem; declared at registration so the
 /// registry can refuse incompatible pairs before anything runs.
 struct TSI_API StepperTraits {
-  int order = 2;                         ///< classical order (uniform in eps on two-scale data)
+  int order = 2;                         ///< order uniform in eps (on two-scale data)
+  /// The order at a fixed eps as h -> 0 when it exceeds `order` (0: equal): a scheme whose
+  /// error bound C h^order holds uniformly while at a given eps it falls faster or erratically
+  /// below it (a composition, exponential collocation); its order is checked on the maximum
+  /// of the errors over eps.
+  int classical_order = 0;
   bool symmetric = false;                ///< step(h) then step(-h) returns the start
   bool implicit = false;                 ///< has implicit stages (fixed-point iteration)
   bool multistep = false;                ///< needs a start-up; reset() starts a new trajectory

@@ -21,8 +21,13 @@ struct Repreparation {
 
 class TwoScale final : public Reformulation {
  public:
+  /// The largest order of prepared data (the recursion's cost grows as 5^(order - 2)).
+  static constexpr int max_data_order = 8;
+
+  /// `recursion`: prepared data from the derivative-free recursion at every order (else the
+  /// closed formulas of SPEC.md for orders 1-3, the recursion above).
   TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order,
-           Repreparation repreparation = {});
+           Repreparation repreparation = {}, bool recursion = false);
 
   Index size() const override { return dim_ * n_tau_; }
   const Vector& linear_multipliers() const override { return multipliers_; }
@@ -41,6 +46,7 @@ class TwoScale final : public Reformulation {
   /// rebuilt as prepared data centred at s_n (U(t_n, s_n) = v_n exactly, u(t_n) unchanged).
   bool between_steps(long n, double t, Vector& y) override;
   std::vector<double> repreparation_times() const override { return repreparation_times_; }
+  int data_order_reached() const override { return data_order_reached_; }
 
  private:
   /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau).
@@ -59,12 +65,23 @@ class TwoScale final : public Reformulation {
   /// Prepared data of the configured order centred at the phase s: U(s) = v exactly (s = 0:
   /// the initial data).
   Vector prepared_at(const Vector& v, double s);
+  /// The closed formulas of SPEC.md (orders 1-3), as coefficients.
+  Matrix closed_data(const Vector& v, double s);
+  /// The derivative-free recursion (SPEC.md, "Higher order"), as coefficients.
+  Matrix recursive_data(const Vector& v, double s);
+  /// Phi^k(u): the mean-free tau dependence of data of order k at base point u, coefficients:
+  ///   Phi^1 = 0,  Phi^k(u) = eps A [ f(u + Phi^{k-1}(u)) + JR Phi^{k-1}(u) - D Phi^{k-1}(u) G ],
+  ///   G = Pi f(u + Phi^{k-1}(u)) + JR u,
+  /// with D Phi^{k-1}(u) G a fourth-order central difference (see the definition).
+  Matrix phi(const Vector& u, int k);
   /// The trigonometric interpolant of coefficients c at tau (Nyquist split half/half).
   Vector evaluate(const Matrix& c, double tau) const;
 
   Index dim_;
   int n_tau_;
   int data_order_;
+  bool recursion_;
+  int data_order_reached_ = 0;  // the order the last preparation reached (recursion: may stop early)
   double eps_;
   RealVector taus_;
   Vector remainder_;  // i omega per model coordinate (empty without a remainder)
