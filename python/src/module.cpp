@@ -338,7 +338,7 @@ py::dict study(const std::string& spec_text, int jobs, const std::vector<std::st
   if (!out_dir.empty()) tsi::app::write_study_files(out_dir, expanded, outcomes, rows, wall, jobs);
   Json head = {{"kind", expanded.kind}, {"title", expanded.title}, {"study", expanded.spec},
                {"varied", expanded.varied}, {"table", rows}, {"wall_seconds", wall}, {"jobs", jobs},
-               {"tsi_version", tsi::version_string}};
+               {"tsi_version", tsi::version_string}, {"not_used", expanded.not_used}};
   if (expanded.kind == "convergence") head["convergence"] = tsi::app::convergence_summary(rows);
   if (expanded.kind == "work-precision") head["work_at_error"] = tsi::app::work_at_error(rows, {1e-4, 1e-6});
   py::list runs;

@@ -143,6 +143,8 @@ class StudyResult:
         head = json.loads(native["study"])
         self.kind, self.title, self.spec = head["kind"], head["title"], head["study"]
         self.varied = head["varied"]
+        # Base settings some runs do not take (path -> their ids); the other runs use them.
+        self.not_used = head.get("not_used", {})
         self.wall_seconds, self.jobs = head["wall_seconds"], head["jobs"]
         self.convergence = head.get("convergence")
         self.work_at_error = head.get("work_at_error")

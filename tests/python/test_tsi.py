@@ -192,6 +192,96 @@ class StudyTests(unittest.TestCase):
             self.assertEqual(float(a["error"]), float(f"{b['error']:.10g}"))
 
 
+class StudyUxTests(unittest.TestCase):
+    """Studies do what a user means: settings some runs take, --set on varied paths,
+    a column per varied path, a hint about plugins."""
+
+    BASE = {"model": {"name": "hh", "eps": 0.1}, "scheme": {"tol": 1e-12}, "time": {"t_end": 0.5}}
+
+    def test_a_base_setting_only_some_schemes_take_is_applied_where_taken(self):
+        s = tsi.study({"base": self.BASE, "vary": {"scheme.name": ["se1", "fd"], "time.h": [0.25, 0.125]}}, jobs=1)
+        self.assertEqual(s.not_used, {"scheme.tol": ["r0003", "r0004"]})
+        for run in s.runs:
+            if run.config["scheme"]["name"] == "se1":
+                self.assertEqual(run.config["scheme"]["tol"], 1e-12)
+            else:
+                self.assertNotIn("tol", run.config["scheme"])
+            self.assertEqual(run.status, "completed")
+        # The tighter tol is really used: more sweeps than at the default 1e-10.
+        loose = tsi.study({"base": with_(self.BASE, scheme={"tol": 1e-10}), "vary": {"scheme.name": ["se1"],
+                                                                                   "time.h": [0.25]}}, jobs=1)
+        self.assertGreater(s.rows[0]["sweeps_mean"], loose.rows[0]["sweeps_mean"])
+
+    def test_a_setting_no_run_takes_is_still_an_error(self):
+        with self.assertRaises(tsi.ConfigError) as caught:
+            tsi.study({"base": with_(self.BASE, scheme={"tolerance": 1e-12}),
+                       "vary": {"scheme.name": ["se1", "fd"]}}, jobs=1)
+        self.assertEqual(caught.exception.field, "scheme.tolerance")
+        self.assertIn("no run of the study takes it", str(caught.exception))
+
+    @unittest.skipUnless(RUNNER, "TSI_TEST_RUNNER not set")
+    def test_the_cli_reports_not_used(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "study.json")
+            with open(path, "w") as f:
+                json.dump({"base": self.BASE, "vary": {"scheme.name": ["se1", "fd"]}}, f)
+            out = subprocess.run([RUNNER, "study", path, "--out", os.path.join(tmp, "o"), "--no-plots"],
+                                 capture_output=True, text=True, check=True).stdout
+            self.assertIn("scheme.tol (from the base) is not used by r0002", out)
+            with open(os.path.join(tmp, "o", "study.json")) as f:
+                self.assertEqual(json.load(f)["not_used"], {"scheme.tol": ["r0002"]})
+
+    def test_set_on_a_varied_path_is_refused(self):
+        spec = {"base": self.BASE, "vary": {"time.h": [0.25, 0.125]},
+                "cases": [{"label": "a"}, {"label": "b", "set": {"scheme": {"name": "se2"}}}]}
+        for path, where in (("time.h", "vary.time.h"), ("scheme.name", "cases[1].set.scheme.name")):
+            with self.assertRaises(tsi.ConfigError) as caught:
+                tsi.study(spec, jobs=1, overrides={path: 0.5})
+            self.assertEqual(caught.exception.field, "--set " + path)
+            self.assertIn(where, str(caught.exception))
+        s = tsi.study(spec, jobs=1, overrides={"model.eps": 0.05})  # a path it does not vary
+        self.assertEqual({r["eps"] for r in s.rows}, {0.05})
+
+    @unittest.skipUnless(RUNNER, "TSI_TEST_RUNNER not set")
+    def test_set_on_a_varied_path_is_refused_by_the_cli(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "study.json")
+            with open(path, "w") as f:
+                json.dump({"base": self.BASE, "vary": {"time.h": [0.25]}}, f)
+            cli = subprocess.run([RUNNER, "study", path, "--out", tmp, "--set", "time.h=0.5"], capture_output=True,
+                                 text=True)
+            self.assertEqual(cli.returncode, 2)
+            self.assertIn("--set time.h: the study varies this path", cli.stderr)
+
+    @unittest.skipUnless(RUNNER, "TSI_TEST_RUNNER not set")
+    def test_table_csv_has_a_column_per_varied_path(self):
+        spec = {"base": {"model": {"name": "nls", "eps": 0.1}, "reformulation": {"n_tau": 16},
+                         "time": {"h": 0.25, "t_end": 0.5}},
+                "vary": {"model.n_x": [8, 16]},
+                "cases": [{"label": "tol", "vary": {"scheme.tol": [1e-8, 1e-10]}},
+                          {"label": "anderson", "set": {"scheme": {"solver": "anderson"}}}]}
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "study.json")
+            with open(path, "w") as f:
+                json.dump(spec, f)
+            subprocess.run([RUNNER, "study", path, "--out", os.path.join(tmp, "o"), "--no-plots"], check=True,
+                           stdout=subprocess.DEVNULL)
+            with open(os.path.join(tmp, "o", "table.csv")) as f:
+                rows = list(csv.DictReader(f))
+        self.assertEqual(len(rows), 6)
+        for column in ("model.n_x", "scheme.tol", "scheme.solver"):
+            self.assertIn(column, rows[0])
+        self.assertEqual([r["model.n_x"] for r in rows], ["8", "8", "16", "16", "8", "16"])
+        self.assertEqual([r["scheme.solver"] for r in rows], ["", "", "", "", "anderson", "anderson"])
+
+    def test_an_unknown_model_mentions_plugins(self):
+        with self.assertRaises(tsi.ConfigError) as caught:
+            tsi.run(with_(HH, model={"name": "fput"}))
+        self.assertEqual(caught.exception.field, "model.name")
+        self.assertIn("--plugin FILE", str(caught.exception))
+        self.assertIn("tsi.load_plugin", str(caught.exception))
+
+
 class PythonModelTests(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
