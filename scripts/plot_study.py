@@ -9,6 +9,10 @@ conservation:   conservation.png    err_H, err_I, err_m against t, one row per s
                                     panel more per invariant the models declare (err_P,
                                     abs_err_P, err_mu: the change columns of invariants.csv)
 work-precision: work_precision.png  error against wall time and against evaluations
+
+The Python package draws the same figures with these functions (tsi.plot, from a study's
+objects): convergence_figure, conservation_figure and work_precision_figure take the rows of
+table.csv (dicts) and return the matplotlib figure.
 """
 import csv
 import json
@@ -18,7 +22,8 @@ import sys
 
 import matplotlib
 
-matplotlib.use("Agg")
+if __name__ == "__main__":  # a script writes files; imported (tsi.plot), the caller's backend stays
+    matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
@@ -47,7 +52,7 @@ def panels(n, width=6.0, height=4.4):
     return fig, list(axes.flat[:n])
 
 
-def plot_convergence(rows, title, out):
+def convergence_figure(rows, title):
     # Failed runs (blow-up, no error) are drawn as red crosses along the top of their panel:
     # a plot never hides them.
     failed = [r for r in rows if not number(r["error"])]
@@ -76,7 +81,7 @@ def plot_convergence(rows, title, out):
         ax.legend(fontsize=8)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "convergence.png"), dpi=110)
+    return fig
 
 
 CHANGES = ("err_H", "err_I", "err_m")
@@ -95,13 +100,19 @@ def declared_changes(inv):
     return [k for k in inv if k.startswith(("err_", "abs_err_")) and k not in CHANGES]
 
 
-def plot_conservation(rows, title, out):
-    names = list(dict.fromkeys(series_name(r) for r in rows))
+def read_runs(rows, out):
+    """Every run's invariants.csv under OUT/runs/, by run id (runs without one left out)."""
     runs = {}
     for r in rows:
         path = os.path.join(out, "runs", r["id"], "invariants.csv")
         if os.path.exists(path):
             runs[r["id"]] = read_invariants(path)
+    return runs
+
+
+def conservation_figure(rows, title, runs):
+    """`runs`: each run's invariants.csv columns by run id (read_runs)."""
+    names = list(dict.fromkeys(series_name(r) for r in rows))
     keys = list(CHANGES)
     for inv in runs.values():
         keys += [k for k in declared_changes(inv) if k not in keys]
@@ -127,10 +138,10 @@ def plot_conservation(rows, title, out):
                 ax.legend(fontsize=7)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "conservation.png"), dpi=100)
+    return fig
 
 
-def plot_work_precision(rows, title, out):
+def work_precision_figure(rows, title):
     rows = [r for r in rows if number(r["error"]) and number(r["wall_seconds"])]
     fig, axes = plt.subplots(1, 2, figsize=(14, 5.2))
     eps_values = sorted({number(r["eps"]) for r in rows}, reverse=True)
@@ -153,7 +164,12 @@ def plot_work_precision(rows, title, out):
     axes[1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "work_precision.png"), dpi=110)
+    return fig
+
+
+# The file each kind's figure goes to, and its resolution.
+FILES = {"convergence": ("convergence.png", 110), "conservation": ("conservation.png", 100),
+         "work-precision": ("work_precision.png", 110)}
 
 
 def main():
@@ -165,10 +181,15 @@ def main():
     with open(os.path.join(out, "table.csv")) as f:
         rows = list(csv.DictReader(f))
     kind, title = study["kind"], study.get("title", "")
-    {"convergence": plot_convergence, "conservation": plot_conservation,
-     "work-precision": plot_work_precision}[kind](rows, title, out)
-    name = {"convergence": "convergence", "conservation": "conservation", "work-precision": "work_precision"}[kind]
-    print(f"  plot: {os.path.join(out, name + '.png')}")
+    if kind == "convergence":
+        fig = convergence_figure(rows, title)
+    elif kind == "conservation":
+        fig = conservation_figure(rows, title, read_runs(rows, out))
+    else:
+        fig = work_precision_figure(rows, title)
+    name, dpi = FILES[kind]
+    fig.savefig(os.path.join(out, name), dpi=dpi)
+    print(f"  plot: {os.path.join(out, name)}")
 
 
 if __name__ == "__main__":

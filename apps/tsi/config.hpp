@@ -1,10 +1,15 @@
 #pragma once
+#include <istream>
 #include <string>
 
 #include "tsi/params.hpp"
 #include "tsi/registry.hpp"
 
 namespace tsi::app {
+
+/// Parses JSON strictly: a duplicated key, nesting deeper than 64 levels or a number beyond a
+/// double is a ConfigError naming where (`origin`, then the key path).
+Json parse_json(std::istream& in, const std::string& origin);
 
 /// Reads a JSON config file; a missing or malformed file is a ConfigError naming it.
 Json load_config_file(const std::string& path);

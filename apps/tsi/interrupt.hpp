@@ -10,4 +10,10 @@ void install_interrupt_handlers();
 int interrupt_signal();
 inline bool interrupted() { return interrupt_signal() != 0; }
 
+/// Asks a run or study to stop at its next step as if `signal` had arrived, without a signal
+/// handler: an embedding (the Python module) that sees the signal itself passes it on here.
+void request_interrupt(int signal);
+/// Forgets a request, so that the next run of the same process goes to its end.
+void clear_interrupt();
+
 }  // namespace tsi::app

@@ -301,6 +301,7 @@ void write_study_files(const std::string& dir, const Study& study, const std::ve
   Json out = {{"tsi_version", version_string}, {"study", study.spec}, {"kind", study.kind},
               {"title", study.title}, {"machine", machine_json()}, {"jobs", jobs},
               {"wall_seconds", wall_seconds}, {"table", rows}};
+  out["not_used"] = study.not_used;
   if (study.kind == "convergence") out["convergence"] = convergence_summary(rows);
   if (study.kind == "work-precision") out["work_at_error"] = work_at_error(rows, {1e-4, 1e-6});
   write_file_atomically(dir + "/study.json", out.dump(2) + "\n");
@@ -308,6 +309,12 @@ void write_study_files(const std::string& dir, const Study& study, const std::ve
 
 std::string study_text(const Study& study, const Json& rows) {
   std::string s = study.title.empty() ? "" : study.title + "\n";
+  for (const auto& [path, ids] : study.not_used.items()) {
+    std::string list;
+    for (size_t k = 0; k < ids.size() && k < 8; ++k) list += (k ? ", " : "") + ids[k].get<std::string>();
+    if (ids.size() > 8) list += fmt::format(", ... ({} runs)", ids.size());
+    s += fmt::format("  {} (from the base) is not used by {}: their scheme or model does not take it\n", path, list);
+  }
   size_t failed = 0;
   for (const auto& row : rows)
     if (row["status"] != "completed") {

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <map>
+
 #include "config.hpp"
 #include "tsi/error.hpp"
 
@@ -28,6 +31,25 @@ std::string describe_assignments(const Json& assignments) {
   return s;
 }
 
+// The leaf paths of a "set" object ("scheme": {"name": "rk78"} sets scheme.name).
+void leaf_paths(const std::string& prefix, const Json& value, std::vector<std::string>& out) {
+  if (value.is_object() && !value.empty()) {
+    for (const auto& [key, inner] : value.items()) leaf_paths(prefix + "." + key, inner, out);
+    return;
+  }
+  out.push_back(prefix);
+}
+
+Json::json_pointer pointer(const std::string& dotted) {
+  std::string p = "/" + dotted;
+  std::replace(p.begin(), p.end(), '.', '/');
+  return Json::json_pointer(p);
+}
+
+bool is_unknown_parameter(const ConfigError& e) {
+  return std::string(e.what()).find("unknown parameter") != std::string::npos;
+}
+
 }  // namespace
 
 Study expand_study(const Json& spec, const Registry& registry, const std::vector<std::string>& overrides) {
@@ -44,12 +66,34 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
   if (!spec.contains("base") || !spec["base"].is_object())
     throw ConfigError("base", "missing or not an object; it is the run config every run starts from");
   Json base = spec["base"];
-  for (const auto& assignment : overrides) apply_override(base, assignment);
-  study.spec["base"] = base;
-
   const auto common = vary_lists(spec.value("vary", Json::object()), "vary");
   Json cases = spec.value("cases", Json::array({Json::object()}));
   if (!cases.is_array() || cases.empty()) throw ConfigError("cases", "expected a non-empty list of cases");
+
+  // A --set on a path the study varies (or a case sets) would be silently replaced: refused.
+  for (const auto& assignment : overrides) {
+    const std::string path = assignment.substr(0, assignment.find('='));
+    std::string where;
+    if (spec.value("vary", Json::object()).is_object() && spec.value("vary", Json::object()).contains(path))
+      where = "vary." + path;
+    for (size_t c = 0; c < cases.size() && where.empty(); ++c) {
+      if (!cases[c].is_object()) continue;
+      const Json vary = cases[c].value("vary", Json::object()), set = cases[c].value("set", Json::object());
+      std::vector<std::string> set_paths;
+      if (set.is_object())
+        for (const auto& [key, value] : set.items()) leaf_paths(key, value, set_paths);
+      if (vary.is_object() && vary.contains(path)) where = fmt::format("cases[{}].vary.{}", c, path);
+      for (const auto& p : set_paths)
+        if (where.empty() && (p == path || p.rfind(path + ".", 0) == 0 || path.rfind(p + ".", 0) == 0))
+          where = fmt::format("cases[{}].set.{}", c, p);
+    }
+    if (!where.empty())
+      throw ConfigError("--set " + path, "the study varies this path (" + where +
+                                             "), which would replace the value set; change the study's list instead");
+  }
+  for (const auto& assignment : overrides) apply_override(base, assignment);
+  study.spec["base"] = base;
+  std::map<std::string, std::string> dropped_message;  // base path -> why a run refused it
 
   for (size_t c = 0; c < cases.size(); ++c) {
     const Json& one = cases[c];
@@ -58,8 +102,14 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
     Json config = base;
     const Json set = one.value("set", Json::object());  // a named copy: items() must not outlive it
     if (!set.is_object()) throw ConfigError(where + ".set", "got " + set.dump() + ", expected an object of path: value");
-    for (const auto& [path, value] : set.items())
+    std::vector<std::string> set_paths;
+    for (const auto& [path, value] : set.items()) {
       assign_path(config, path, value, where + ".set." + path);
+      leaf_paths(path, value, set_paths);
+    }
+    for (const auto& path : set_paths)  // a path a case sets varies from case to case: a column too
+      if (std::find(study.varied.begin(), study.varied.end(), path) == study.varied.end())
+        study.varied.push_back(path);
     auto lists = common;
     for (auto& [path, values] : vary_lists(one.value("vary", Json::object()), where + ".vary")) {
       auto it = std::find_if(lists.begin(), lists.end(), [&](const auto& p) { return p.first == path; });
@@ -85,18 +135,34 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
       run.label = one.value("label", std::string());
       run.assignments = Json::object();
       Json raw = config;
+      for (const auto& path : set_paths)
+        if (raw.contains(pointer(path))) run.assignments[path] = raw.at(pointer(path));
       for (size_t k = 0; k < lists.size(); ++k) {
         const Json& value = lists[k].second[index[k]];
         run.assignments[lists[k].first] = value;
         assign_path(raw, lists[k].first, value, "vary." + lists[k].first);
       }
-      try {
-        run.config = resolve_run_config(raw, registry);
-      } catch (const ConfigError& e) {
-        const std::string what = e.what();
-        const std::string message = e.field().empty() ? what : what.substr(e.field().size() + 2);
-        throw ConfigError(e.field(), fmt::format("{} (run {}: {})", message, run.id,
-                                                 describe_assignments(run.assignments)));
+      for (;;) {
+        try {
+          run.config = resolve_run_config(raw, registry);
+          break;
+        } catch (const ConfigError& e) {
+          // A base setting this run's scheme or model does not take (scheme.tol for fd when the
+          // study varies se1 and fd) is left out of this run and reported; a setting no run
+          // takes is still an error (after the expansion), so that typos are caught.
+          const std::string& field = e.field();
+          if (is_unknown_parameter(e) && !field.empty() && base.contains(pointer(field)) &&
+              !run.assignments.contains(field) && raw.contains(pointer(field))) {
+            raw.at(pointer(field).parent_pointer()).erase(pointer(field).back());
+            study.not_used[field].push_back(run.id);
+            dropped_message.emplace(field, std::string(e.what()).substr(field.size() + 2));
+            continue;
+          }
+          const std::string what = e.what();
+          const std::string message = field.empty() ? what : what.substr(field.size() + 2);
+          throw ConfigError(field, fmt::format("{} (run {}: {})", message, run.id,
+                                               describe_assignments(run.assignments)));
+        }
       }
       study.runs.push_back(std::move(run));
       done = true;
@@ -109,6 +175,9 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
       }
     }
   }
+  for (const auto& [path, ids] : study.not_used.items())
+    if (ids.size() == study.runs.size())
+      throw ConfigError(path, dropped_message[path] + " (set in the base, and no run of the study takes it)");
   return study;
 }
 

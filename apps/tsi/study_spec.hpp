@@ -25,7 +25,10 @@ struct Study {
   std::string title;
   Json spec;  ///< the study file as given (after --set on its base)
   std::vector<StudyRun> runs;
-  std::vector<std::string> varied;  ///< every varied path, in first-seen order
+  std::vector<std::string> varied;  ///< every varied path (and every path a case sets), in first-seen order
+  /// Base settings that only some runs take (a parameter of some schemes or models only): path
+  /// -> the ids of the runs that do not take it. The others run with it.
+  Json not_used = Json::object();
 };
 
 /// Validates and expands a study; every run is resolved before any runs, so a bad path or

@@ -64,7 +64,12 @@ struct Table {
       const auto& a = e.info.aliases;
       if (!a.empty()) list += (a.size() == 1 ? " (alias: " : " (aliases: ") + join(a) + ")";
     }
-    throw ConfigError(field, unknown + "valid " + plural + " are: " + list);
+    // Models and schemes also come from plugins: one that was not loaded is the likely miss.
+    const std::string hint = kind == "reformulation" ? ""
+                                                     : "; a " + kind + " from a plugin needs the plugin loaded: --plugin "
+                                                       "FILE, TSI_PLUGIN_PATH, the config's \"plugins\" list, or "
+                                                       "tsi.load_plugin(FILE) in Python";
+    throw ConfigError(field, unknown + "valid " + plural + " are: " + list + hint);
   }
 
   std::vector<const Entry*> sorted() const {

@@ -69,12 +69,12 @@ TEST_SUITE("tsi_runner_tests") {
 
 TEST_CASE("run errors: an unknown model lists the valid models") {
   check_bad_input(run_example_with({"model.name=no-such-model"}), "model.name",
-                  {"unknown model", "\"no-such-model\"", "henon-heiles", "hh"});
+                  {"unknown model", "\"no-such-model\"", "henon-heiles", "hh", "from a plugin needs the plugin loaded: --plugin FILE"});
 }
 
 TEST_CASE("run errors: an unknown scheme lists the valid schemes") {
   check_bad_input(run_example_with({"scheme.name=no-such-scheme"}), "scheme.name",
-                  {"unknown scheme", "\"no-such-scheme\"", "se1", "rk78"});
+                  {"unknown scheme", "\"no-such-scheme\"", "se1", "rk78", "--plugin FILE"});
 }
 
 TEST_CASE("run errors: an unknown reformulation lists the valid reformulations") {

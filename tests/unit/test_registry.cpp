@@ -54,7 +54,8 @@ TEST_CASE("registry: a miss lists the valid names, sorted, with their aliases") 
   CHECK_THROWS_WITH_AS(
       r.model("foo"),
       "model.name: unknown model \"foo\"; valid models are: cpd (alias: charged-particle), "
-      "henon-heiles (alias: hh)",
+      "henon-heiles (alias: hh); a model from a plugin needs the plugin loaded: --plugin FILE, TSI_PLUGIN_PATH, "
+      "the config's \"plugins\" list, or tsi.load_plugin(FILE) in Python",
       tsi::ConfigError);
   try {
     r.scheme("x", "run.scheme");

@@ -1,0 +1,412 @@
+// tsi._tsi: the native half of the Python package (python/tsi/__init__.py is the other).
+// Everything goes through the runner's library (apps/tsi: resolve_run_config, execute_run,
+// expand_study, run_study, study_rows), so a config means in Python what it means to `tsi run`.
+// Configs and results cross as JSON text; the package turns them into dicts and numpy arrays.
+#include <fmt/format.h>
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <csignal>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "config.hpp"
+#include "interrupt.hpp"
+#include "list_command.hpp"
+#include "plugin_setup.hpp"
+#include "run.hpp"
+#include "run_files.hpp"
+#include "study_report.hpp"
+#include "study_runner.hpp"
+#include "study_spec.hpp"
+#include "tsi/error.hpp"
+#include "tsi/model.hpp"
+#include "tsi/plugin_loader.hpp"
+#include "tsi/registry.hpp"
+#include "tsi/version.hpp"
+
+namespace py = pybind11;
+using tsi::Json;
+
+namespace {
+
+// The process-wide registry and loader, shared with every plugin loaded from Python. Never
+// destroyed: plugins and Python models registered into it live as long as the process.
+tsi::PluginLoader& loader() {
+  static auto* instance = new tsi::PluginLoader(tsi::Registry::global());
+  return *instance;
+}
+
+Json parse(const std::string& text, const std::string& origin) {
+  std::istringstream in(text);
+  return tsi::app::parse_json(in, origin);
+}
+
+// Runs `work` on a worker thread while this (the Python main) thread waits with the GIL
+// released, waking every 50 ms to let Python handle its signals: a Ctrl-C (KeyboardInterrupt)
+// becomes the runner's interrupt request, and the run or study stops at its next step and
+// returns what it has (status "interrupted"). Exceptions of `work` are rethrown here.
+template <class Result, class Work>
+Result interruptible(Work&& work, bool& was_interrupted) {
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool done = false;
+  Result result{};
+  std::exception_ptr error;
+  tsi::app::clear_interrupt();
+  std::thread worker([&] {
+    try {
+      result = work();
+    } catch (...) {
+      error = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(mutex);
+    done = true;
+    cv.notify_all();
+  });
+  was_interrupted = false;
+  for (;;) {
+    bool finished = false;
+    {
+      py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(mutex);
+      finished = cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; });
+    }
+    if (finished) break;
+    if (PyErr_CheckSignals() != 0) {  // KeyboardInterrupt (or another handler's exception)
+      PyErr_Clear();
+      was_interrupted = true;
+      tsi::app::request_interrupt(SIGINT);
+    }
+  }
+  {
+    py::gil_scoped_release release;
+    worker.join();
+  }
+  tsi::app::clear_interrupt();
+  if (error) std::rethrow_exception(error);
+  return result;
+}
+
+// ---- Models written in Python -------------------------------------------------------------
+
+// Calls into a Python model, with the GIL, turning a Python exception into a tsi::Error that
+// names the model and the method (the run then fails with that message, as a C++ model's would).
+template <class F>
+auto call_python(const std::string& model, const char* method, F&& f) {
+  py::gil_scoped_acquire gil;
+  try {
+    return f();
+  } catch (py::error_already_set& e) {
+    throw tsi::Error(fmt::format("python model \"{}\": {}: {}", model, method, e.what()));
+  } catch (const py::cast_error& e) {
+    throw tsi::Error(fmt::format("python model \"{}\": {} returned a value of the wrong type: {}", model, method,
+                                 e.what()));
+  }
+}
+
+class PythonModel final : public tsi::Model {
+ public:
+  PythonModel(double eps, py::object instance, std::string name)
+      : Model(eps), name_(std::move(name)), self_(instance.release().ptr()) {
+    py::handle self(self_);
+    dim_ = self.attr("dim").cast<tsi::Index>();
+    if (dim_ <= 0) throw tsi::ConfigError("model.name", fmt::format("python model \"{}\": dim = {}, expected a positive integer", name_, dim_));
+    complex_ = py::hasattr(self, "is_complex") && self.attr("is_complex").cast<bool>();
+    has_filtered_ = py::hasattr(self, "filtered_field");
+    has_derivative_ = py::hasattr(self, "nonlinear_field_derivative");
+    max_frequency_ = py::hasattr(self, "max_linear_frequency") ? self.attr("max_linear_frequency").cast<double>() : 1.0;
+  }
+  ~PythonModel() override {
+    if (Py_IsInitialized()) {
+      py::gil_scoped_acquire gil;
+      py::handle(self_).dec_ref();
+    }
+  }
+
+  tsi::Index dim() const override { return dim_; }
+  bool is_complex() const override { return complex_; }
+  double max_linear_frequency() const override { return max_frequency_; }
+
+  void linear_flow(const tsi::RealVector& taus, tsi::MatrixRef states) const override {
+    call_python(name_, "linear_flow", [&] {
+      store(states, self().attr("linear_flow")(taus, batch(states)), "linear_flow");
+    });
+  }
+
+  void nonlinear_field(tsi::ConstMatrixRef states, tsi::MatrixRef out) const override {
+    call_python(name_, "nonlinear_field", [&] {
+      store(out, self().attr("nonlinear_field")(batch(states)), "nonlinear_field");
+    });
+  }
+
+  void filtered_field(const tsi::RealVector& taus, tsi::MatrixRef states, tsi::MatrixRef out) const override {
+    if (!has_filtered_) return Model::filtered_field(taus, states, out);
+    call_python(name_, "filtered_field", [&] {
+      store(out, self().attr("filtered_field")(taus, batch(states)), "filtered_field");
+    });
+  }
+
+  // The run's tau grid as a numpy array made once, handed to filtered_field at every call.
+  class GridField final : public tsi::TauGridField {
+   public:
+    GridField(const PythonModel& model, const tsi::RealVector& taus) : model_(model), taus_(taus) {
+      py::gil_scoped_acquire gil;
+      array_ = py::cast(taus_).release().ptr();
+    }
+    ~GridField() override {
+      if (Py_IsInitialized()) {
+        py::gil_scoped_acquire gil;
+        py::handle(array_).dec_ref();
+      }
+    }
+    void evaluate(tsi::MatrixRef states, tsi::MatrixRef out) override {
+      if (!model_.has_filtered_) return model_.Model::filtered_field(taus_, states, out);
+      call_python(model_.name_, "filtered_field", [&] {
+        model_.store(out, model_.self().attr("filtered_field")(py::handle(array_), model_.batch(states)),
+                     "filtered_field");
+      });
+    }
+
+   private:
+    const PythonModel& model_;
+    tsi::RealVector taus_;
+    PyObject* array_;
+  };
+
+  std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
+    return std::make_unique<GridField>(*this, taus);
+  }
+
+  void nonlinear_field_derivative(tsi::ConstMatrixRef states, tsi::ConstMatrixRef directions,
+                                  tsi::MatrixRef out) const override {
+    if (!has_derivative_) return Model::nonlinear_field_derivative(states, directions, out);
+    call_python(name_, "nonlinear_field_derivative", [&] {
+      store(out, self().attr("nonlinear_field_derivative")(batch(states), batch(directions)),
+            "nonlinear_field_derivative");
+    });
+  }
+
+  void apply_M(const tsi::Vector& u, tsi::Vector& out) const override {
+    out = call_python(name_, "apply_M", [&] { return vector(self().attr("apply_M")(one(u)), "apply_M"); });
+  }
+  void apply_J(const tsi::Vector& u, tsi::Vector& out) const override {
+    out = call_python(name_, "apply_J", [&] { return vector(self().attr("apply_J")(one(u)), "apply_J"); });
+  }
+  double H1(const tsi::Vector& u) const override {
+    return call_python(name_, "H1", [&] { return self().attr("H1")(one(u)).cast<double>(); });
+  }
+  tsi::Vector initial_value() const override {
+    return call_python(name_, "initial_value",
+                       [&] { return vector(self().attr("initial_value")(), "initial_value"); });
+  }
+
+ private:
+  py::handle self() const { return py::handle(self_); }
+
+  // States as numpy arrays, one column per state: float64 for a real model (the real parts),
+  // complex128 otherwise.
+  py::object batch(tsi::ConstMatrixRef states) const {
+    if (complex_) return py::cast(tsi::Matrix(states));
+    return py::cast(Eigen::MatrixXd(states.real()));
+  }
+  py::object one(const tsi::Vector& u) const {
+    if (complex_) return py::cast(u);
+    return py::cast(tsi::RealVector(u.real()));
+  }
+
+  void store(tsi::MatrixRef out, const py::object& value, const char* method) const {
+    const tsi::Matrix m = value.cast<tsi::Matrix>();
+    if (m.rows() != out.rows() || m.cols() != out.cols())
+      throw tsi::Error(fmt::format("python model \"{}\": {} returned shape ({}, {}), expected ({}, {}): one column "
+                                   "per state",
+                                   name_, method, m.rows(), m.cols(), out.rows(), out.cols()));
+    out = m;
+  }
+  tsi::Vector vector(const py::object& value, const char* method) const {
+    const tsi::Vector v = value.cast<tsi::Vector>();
+    if (v.size() != dim_)
+      throw tsi::Error(fmt::format("python model \"{}\": {} returned {} entries, expected dim = {}", name_, method,
+                                   v.size(), dim_));
+    return v;
+  }
+
+  std::string name_;
+  PyObject* self_;
+  tsi::Index dim_ = 0;
+  bool complex_ = false, has_filtered_ = false, has_derivative_ = false;
+  double max_frequency_ = 1.0;
+};
+
+tsi::ParamSpec param_from_default(const std::string& name, const Json& value) {
+  const std::string description = "a parameter of the python model";
+  if (value.is_boolean()) return tsi::bool_param(name, value, description);
+  if (value.is_number_integer()) return tsi::integer_param(name, value, description);
+  if (value.is_number()) return tsi::number_param(name, value, description);
+  if (value.is_string()) return tsi::string_param(name, value, description);
+  if (value.is_array()) return tsi::array_param(name, description);
+  throw tsi::ConfigError("params." + name, "got " + value.dump() + ", expected a number, integer, boolean, string or list default");
+}
+
+// Registers (or re-registers: a notebook cell run twice) a Python class as model `name`.
+void register_python_model(const std::string& name, py::object cls, const std::string& params_text,
+                           const std::vector<std::string>& aliases, int n_tau, int degree, const std::string& summary) {
+  if (n_tau < 2 || n_tau % 2 != 0) throw tsi::ConfigError("n_tau", fmt::format("got {}, expected a positive even integer", n_tau));
+  if (degree < 0) throw tsi::ConfigError("nonlinearity_degree", fmt::format("got {}, expected 0 (not polynomial) or the degree", degree));
+  const Json params = parse(params_text, "params");
+  tsi::ModelEntry entry;
+  entry.info.name = name;
+  entry.info.aliases = aliases;
+  entry.info.summary = summary.empty() ? "a model written in Python" : summary;
+  for (const auto& [key, value] : params.items()) entry.info.params.push_back(param_from_default(key, value));
+  entry.default_n_tau = n_tau;
+  entry.nonlinearity_degree = degree;
+  // The class is kept for the life of the process (the registry outlives the interpreter's
+  // objects at exit): one reference, never released.
+  PyObject* class_ref = cls.release().ptr();
+  entry.create = [class_ref, name](const tsi::Params& p) -> std::unique_ptr<tsi::Model> {
+    return call_python(name, "__init__", [&] {
+      py::dict kwargs;
+      for (const auto& [key, value] : p.raw().items())
+        if (key != "eps" && key != "u0") kwargs[py::str(key)] = py::module_::import("json").attr("loads")(value.dump());
+      const double eps = p.number("eps");
+      py::object instance = py::handle(class_ref)(eps, **kwargs);
+      return std::make_unique<PythonModel>(eps, instance, name);
+    });
+  };
+  tsi::Registry& registry = tsi::Registry::global();
+  const std::string provider = "python:" + name;
+  registry.remove_provider(provider);
+  const std::string previous = registry.provider();
+  registry.set_provider(provider);
+  try {
+    registry.add_model(std::move(entry));
+  } catch (...) {
+    registry.set_provider(previous);
+    throw;
+  }
+  registry.set_provider(previous);
+}
+
+// ---- Runs and studies -------------------------------------------------------------------------
+
+py::dict outcome_dict(const tsi::app::RunOutcome& outcome) {
+  py::dict d;
+  d["result"] = outcome.result.dump();
+  d["csv"] = outcome.csv;
+  d["ok"] = outcome.ok;
+  d["message"] = outcome.message;
+  return d;
+}
+
+py::dict run(const std::string& config_text, const std::string& out_dir) {
+  tsi::Registry& registry = tsi::Registry::global();
+  const Json raw = parse(config_text, "config");
+  if (raw.is_object() && raw.contains("plugins")) tsi::app::load_config_plugins(loader(), raw["plugins"], "./config");
+  const Json config = tsi::app::resolve_run_config(raw, registry);
+  if (!out_dir.empty()) tsi::app::prepare_output_dir(out_dir);
+  bool was_interrupted = false;
+  const auto outcome = interruptible<tsi::app::RunOutcome>(
+      [&] { return tsi::app::execute_run(config, registry); }, was_interrupted);
+  if (!out_dir.empty()) tsi::app::write_run_files(out_dir, outcome);
+  py::dict d = outcome_dict(outcome);
+  d["interrupted"] = was_interrupted;
+  return d;
+}
+
+py::dict study(const std::string& spec_text, int jobs, const std::vector<std::string>& overrides,
+               const std::string& out_dir) {
+  tsi::Registry& registry = tsi::Registry::global();
+  const Json spec = parse(spec_text, "study");
+  if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
+    tsi::app::load_config_plugins(loader(), spec["base"]["plugins"], "./study");
+  const tsi::app::Study expanded = tsi::app::expand_study(spec, registry, overrides);
+  if (jobs <= 0) jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (!out_dir.empty()) tsi::app::prepare_output_dir(out_dir);
+  bool was_interrupted = false;
+  const auto start = std::chrono::steady_clock::now();
+  const auto outcomes = interruptible<std::vector<tsi::app::RunOutcome>>(
+      [&] { return tsi::app::run_study(expanded, registry, jobs); }, was_interrupted);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const Json rows = tsi::app::study_rows(expanded, outcomes);
+  if (!out_dir.empty()) tsi::app::write_study_files(out_dir, expanded, outcomes, rows, wall, jobs);
+  Json head = {{"kind", expanded.kind}, {"title", expanded.title}, {"study", expanded.spec},
+               {"varied", expanded.varied}, {"table", rows}, {"wall_seconds", wall}, {"jobs", jobs},
+               {"tsi_version", tsi::version_string}, {"not_used", expanded.not_used}};
+  if (expanded.kind == "convergence") head["convergence"] = tsi::app::convergence_summary(rows);
+  if (expanded.kind == "work-precision") head["work_at_error"] = tsi::app::work_at_error(rows, {1e-4, 1e-6});
+  py::list runs;
+  for (size_t i = 0; i < outcomes.size(); ++i) {
+    py::dict r = outcome_dict(outcomes[i]);
+    r["id"] = expanded.runs[i].id;
+    r["label"] = expanded.runs[i].label;
+    r["assignments"] = expanded.runs[i].assignments.dump();
+    runs.append(r);
+  }
+  py::dict d;
+  d["study"] = head.dump();
+  d["runs"] = runs;
+  d["interrupted"] = was_interrupted;
+  return d;
+}
+
+// The exception classes: tsi.Error, and under it tsi.ConfigError (with .field) and
+// tsi.PluginError. Created once at import and kept for the life of the process.
+PyObject* error_type = nullptr;
+PyObject* config_error_type = nullptr;
+PyObject* plugin_error_type = nullptr;
+
+void translate(std::exception_ptr p) {
+  try {
+    if (p) std::rethrow_exception(p);
+  } catch (const tsi::ConfigError& e) {
+    py::object instance = py::handle(config_error_type)(e.what());
+    instance.attr("field") = e.field();
+    PyErr_SetObject(config_error_type, instance.ptr());
+  } catch (const tsi::PluginError& e) {
+    PyErr_SetString(plugin_error_type, e.what());
+  } catch (const tsi::Error& e) {
+    PyErr_SetString(error_type, e.what());
+  }
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_tsi, m) {
+  m.doc() = "tsi's native module: use the package tsi";
+  m.attr("version") = tsi::version_string;
+
+  error_type = PyErr_NewExceptionWithDoc("tsi.Error", "An error tsi reports.", PyExc_RuntimeError, nullptr);
+  config_error_type =
+      PyErr_NewExceptionWithDoc("tsi.ConfigError", "Bad input; .field names the config path.", error_type, nullptr);
+  plugin_error_type = PyErr_NewExceptionWithDoc("tsi.PluginError", "A plugin that could not be loaded or registered.",
+                                                error_type, nullptr);
+  m.add_object("Error", py::handle(error_type));
+  m.add_object("ConfigError", py::handle(config_error_type));
+  m.add_object("PluginError", py::handle(plugin_error_type));
+  py::register_exception_translator(&translate);
+
+  m.def(
+      "init",
+      [] {
+        tsi::Registry& registry = tsi::Registry::global();
+        return tsi::app::load_plugins(loader(), registry, {});
+      },
+      "Registers the core and loads the shipped plugins and TSI_PLUGIN_PATH; returns the warnings.");
+  m.def("list", [](const std::string& what) { return tsi::app::list_json(tsi::Registry::global(), what).dump(); },
+        py::arg("what") = "");
+  m.def("load_plugin", [](const std::string& path) { loader().load(path); }, py::arg("path"));
+  m.def("plugin_directory", &tsi::PluginLoader::default_directory);
+  m.def("run", &run, py::arg("config"), py::arg("out") = "");
+  m.def("study", &study, py::arg("spec"), py::arg("jobs") = 0, py::arg("overrides") = std::vector<std::string>(),
+        py::arg("out") = "");
+  m.def("register_model", &register_python_model, py::arg("name"), py::arg("cls"), py::arg("params") = "{}",
+        py::arg("aliases") = std::vector<std::string>(), py::arg("n_tau") = 64, py::arg("nonlinearity_degree") = 0,
+        py::arg("summary") = "");
+}

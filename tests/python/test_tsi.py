@@ -1,0 +1,448 @@
+"""The Python package tsi: runs, studies, errors, models written in Python, plots, Ctrl-C.
+
+Run by ctest with PYTHONPATH=<build>/python and TSI_TEST_RUNNER=<build>/bin/tsi, one ctest
+test per class:  /usr/bin/python3 tests/python/test_tsi.py RunTests
+"""
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import unittest
+
+import numpy as np
+
+import tsi
+from tsi.models import HenonHeiles
+
+RUNNER = os.environ.get("TSI_TEST_RUNNER", "")
+
+HH = {"model": {"name": "henon-heiles", "eps": 0.01}, "scheme": {"name": "se1"},
+      "time": {"h": 0.125, "t_end": 1.0}, "reference": {}}
+
+
+def with_(config, **sections):
+    out = json.loads(json.dumps(config))
+    for key, value in sections.items():
+        out.setdefault(key, {}).update(value)
+    return out
+
+
+def have(module):
+    try:
+        __import__(module)
+        return True
+    except ImportError:
+        return False
+
+
+class RunTests(unittest.TestCase):
+    def test_list_names_the_shipped_models_and_schemes(self):
+        listing = tsi.list()
+        self.assertIn("henon-heiles", [m["name"] for m in listing["models"]])
+        self.assertIn("se1", [s["name"] for s in listing["schemes"]])
+        self.assertEqual([s["name"] for s in tsi.list("schemes")], [s["name"] for s in listing["schemes"]])
+
+    def test_run_returns_numpy_arrays_consistent_with_each_other(self):
+        r = tsi.run(HH)
+        self.assertEqual(r.status, "completed")
+        self.assertEqual(r.u_final.shape, (4,))
+        self.assertEqual(r.u_final.dtype, np.float64)
+        self.assertEqual(r.reference.shape, (4,))
+        # The relative error recomputed from the two states the result carries.
+        own = np.linalg.norm(r.u_final - r.reference) / np.linalg.norm(r.reference)
+        self.assertAlmostEqual(r.error / own, 1.0, delta=1e-12)
+        self.assertGreater(r.error, 1e-7)
+        self.assertLess(r.error, 1e-3)
+        # One row per step and the initial one; the largest err_H is the one result.json reports.
+        self.assertEqual(len(r.t), r.steps + 1)
+        self.assertEqual(r.steps, 8)
+        self.assertAlmostEqual(r.t[-1], 1.0, delta=1e-12)
+        self.assertEqual(r.invariants["err_H"][0], 0.0)
+        self.assertAlmostEqual(r.invariants["err_H"].max(), r.result["invariants"]["H"]["max_rel_error"],
+                               delta=1e-6 * r.invariants["err_H"].max())  # the file's 7 digits
+
+    @unittest.skipUnless(RUNNER, "TSI_TEST_RUNNER not set")
+    def test_run_computes_what_the_cli_computes(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "hh.json")
+            with open(path, "w") as f:
+                json.dump(HH, f)
+            subprocess.run([RUNNER, "run", path, "--out", os.path.join(tmp, "cli")], check=True,
+                           stdout=subprocess.DEVNULL)
+            with open(os.path.join(tmp, "cli", "result.json")) as f:
+                cli = json.load(f)
+            r = tsi.run(HH, out=os.path.join(tmp, "py"))
+            self.assertEqual(r.u_final.tolist(), cli["u_final"])
+            self.assertEqual(r.error, cli["error"]["relative"])
+            self.assertEqual(r.config, cli["config"])
+            with open(os.path.join(tmp, "py", "result.json")) as f:
+                self.assertEqual(json.load(f)["u_final"], cli["u_final"])
+
+    def test_a_complex_model_gives_a_complex_state(self):
+        r = tsi.run({"model": {"name": "nls", "eps": 0.1, "n_x": 8}, "reformulation": {"n_tau": 16},
+                     "time": {"h": 0.25, "t_end": 0.5}})
+        self.assertEqual(r.status, "completed")
+        self.assertEqual(r.u_final.dtype, np.complex128)
+        self.assertEqual(r.u_final.shape, (8,))
+        self.assertIsNone(r.error)
+
+    def test_numpy_values_in_a_config_are_accepted(self):
+        r = tsi.run(with_(HH, model={"eps": np.float64(0.01)}, time={"h": np.float32(0.25)}))
+        self.assertEqual(r.steps, 4)
+
+
+class ErrorTests(unittest.TestCase):
+    def assert_field(self, config, field, words):
+        with self.assertRaises(tsi.ConfigError) as caught:
+            tsi.run(config)
+        self.assertEqual(caught.exception.field, field)
+        self.assertIn(words, str(caught.exception))
+        self.assertIsInstance(caught.exception, tsi.Error)
+
+    def test_bad_values_name_their_field(self):
+        self.assert_field(with_(HH, model={"eps": 2}), "model.eps", "expected a number in (0, 1]")
+        self.assert_field(with_(HH, time={"h": 0.3}), "time.h", "whole number of steps")
+        self.assert_field(with_(HH, scheme={"tol": "tight"}), "scheme.tol", "tight")
+        self.assert_field(with_(HH, model={"name": "no-such-model"}), "model.name", "no-such-model")
+        self.assert_field({"model": {"name": "hh"}, "modle": {}}, "modle", "unknown section")
+
+    @unittest.skipUnless(RUNNER, "TSI_TEST_RUNNER not set")
+    def test_the_message_is_the_clis(self):
+        bad = with_(HH, model={"eps": 2})
+        with self.assertRaises(tsi.ConfigError) as caught:
+            tsi.run(bad)
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "bad.json")
+            with open(path, "w") as f:
+                json.dump(bad, f)
+            cli = subprocess.run([RUNNER, "run", path, "--out", tmp], capture_output=True, text=True)
+        self.assertEqual(cli.returncode, 2)
+        self.assertIn(str(caught.exception), cli.stderr)
+
+    def test_a_plugin_that_cannot_load_is_a_plugin_error(self):
+        with self.assertRaises(tsi.PluginError):
+            tsi.load_plugin("/nonexistent/tsi_nothing.so")
+
+    def test_a_study_with_a_bad_path_names_it(self):
+        with self.assertRaises(tsi.ConfigError) as caught:
+            tsi.study({"base": HH, "vary": {"model.eps": [0.1, 7]}})
+        self.assertEqual(caught.exception.field, "model.eps")
+        self.assertIn("r0002", str(caught.exception))
+
+
+class StudyTests(unittest.TestCase):
+    SPEC = {"kind": "convergence", "title": "se1 and fd on Henon-Heiles",
+            "base": {"model": {"name": "henon-heiles"}, "time": {"t_end": 1}, "reference": {}},
+            "vary": {"scheme.name": ["se1", "fd"], "model.eps": [1, 0.0625], "time.h": [0.25, 0.125, 0.0625]}}
+
+    @classmethod
+    def setUpClass(cls):
+        cls.study = tsi.study(cls.SPEC, jobs=2)
+
+    def test_rows_and_runs(self):
+        s = self.study
+        self.assertEqual(len(s.rows), 12)
+        self.assertEqual([r.id for r in s.runs], [row["id"] for row in s.rows])
+        for row, run in zip(s.rows, s.runs):
+            self.assertEqual(row["status"], "completed")
+            self.assertEqual(row["error"], run.error)
+            self.assertEqual(row["scheme"], run.config["scheme"]["name"])
+            self.assertEqual(row["time.h"], run.assignments["time.h"])
+            self.assertEqual(len(run.t), round(1 / row["h"]) + 1)
+
+    def test_orders_are_two(self):
+        orders = [row["order"] for row in self.study.rows if row["order"] is not None]
+        self.assertEqual(len(orders), 8)
+        for order in orders:
+            self.assertGreater(order, 1.9)
+            self.assertLess(order, 2.1)
+        fits = [series["least_squares_order"] for series in self.study.convergence["series"]]
+        self.assertEqual(len(fits), 4)
+        for order in fits:
+            self.assertAlmostEqual(order, 2.0, delta=0.1)
+
+    @unittest.skipUnless(have("pandas"), "pandas not installed")
+    def test_to_pandas(self):
+        df = self.study.to_pandas()
+        self.assertEqual(len(df), 12)
+        self.assertEqual(list(df["error"]), [row["error"] for row in self.study.rows])
+        self.assertIn("time.h", df.columns)
+
+    def test_overrides_apply_to_the_base(self):
+        s = tsi.study({"base": HH, "vary": {"time.h": [0.5, 0.25]}}, jobs=1, overrides={"scheme.name": "se2"})
+        self.assertEqual({r["scheme"] for r in s.rows}, {"se2"})
+
+    @unittest.skipUnless(RUNNER, "TSI_TEST_RUNNER not set")
+    def test_the_cli_writes_the_same_table(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "study.json")
+            with open(path, "w") as f:
+                json.dump(self.SPEC, f)
+            subprocess.run([RUNNER, "study", path, "--out", os.path.join(tmp, "cli"), "--no-plots", "--jobs", "2"],
+                           check=True, stdout=subprocess.DEVNULL)
+            with open(os.path.join(tmp, "cli", "table.csv")) as f:
+                cli = list(csv.DictReader(f))
+        self.assertEqual([r["id"] for r in cli], [r["id"] for r in self.study.rows])
+        for a, b in zip(cli, self.study.rows):
+            self.assertEqual(float(a["error"]), float(f"{b['error']:.10g}"))
+
+
+class StudyUxTests(unittest.TestCase):
+    """Studies do what a user means: settings some runs take, --set on varied paths,
+    a column per varied path, a hint about plugins."""
+
+    BASE = {"model": {"name": "hh", "eps": 0.1}, "scheme": {"tol": 1e-12}, "time": {"t_end": 0.5}}
+
+    def test_a_base_setting_only_some_schemes_take_is_applied_where_taken(self):
+        s = tsi.study({"base": self.BASE, "vary": {"scheme.name": ["se1", "fd"], "time.h": [0.25, 0.125]}}, jobs=1)
+        self.assertEqual(s.not_used, {"scheme.tol": ["r0003", "r0004"]})
+        for run in s.runs:
+            if run.config["scheme"]["name"] == "se1":
+                self.assertEqual(run.config["scheme"]["tol"], 1e-12)
+            else:
+                self.assertNotIn("tol", run.config["scheme"])
+            self.assertEqual(run.status, "completed")
+        # The tighter tol is really used: more sweeps than at the default 1e-10.
+        loose = tsi.study({"base": with_(self.BASE, scheme={"tol": 1e-10}), "vary": {"scheme.name": ["se1"],
+                                                                                   "time.h": [0.25]}}, jobs=1)
+        self.assertGreater(s.rows[0]["sweeps_mean"], loose.rows[0]["sweeps_mean"])
+
+    def test_a_setting_no_run_takes_is_still_an_error(self):
+        with self.assertRaises(tsi.ConfigError) as caught:
+            tsi.study({"base": with_(self.BASE, scheme={"tolerance": 1e-12}),
+                       "vary": {"scheme.name": ["se1", "fd"]}}, jobs=1)
+        self.assertEqual(caught.exception.field, "scheme.tolerance")
+        self.assertIn("no run of the study takes it", str(caught.exception))
+
+    @unittest.skipUnless(RUNNER, "TSI_TEST_RUNNER not set")
+    def test_the_cli_reports_not_used(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "study.json")
+            with open(path, "w") as f:
+                json.dump({"base": self.BASE, "vary": {"scheme.name": ["se1", "fd"]}}, f)
+            out = subprocess.run([RUNNER, "study", path, "--out", os.path.join(tmp, "o"), "--no-plots"],
+                                 capture_output=True, text=True, check=True).stdout
+            self.assertIn("scheme.tol (from the base) is not used by r0002", out)
+            with open(os.path.join(tmp, "o", "study.json")) as f:
+                self.assertEqual(json.load(f)["not_used"], {"scheme.tol": ["r0002"]})
+
+    def test_set_on_a_varied_path_is_refused(self):
+        spec = {"base": self.BASE, "vary": {"time.h": [0.25, 0.125]},
+                "cases": [{"label": "a"}, {"label": "b", "set": {"scheme": {"name": "se2"}}}]}
+        for path, where in (("time.h", "vary.time.h"), ("scheme.name", "cases[1].set.scheme.name")):
+            with self.assertRaises(tsi.ConfigError) as caught:
+                tsi.study(spec, jobs=1, overrides={path: 0.5})
+            self.assertEqual(caught.exception.field, "--set " + path)
+            self.assertIn(where, str(caught.exception))
+        s = tsi.study(spec, jobs=1, overrides={"model.eps": 0.05})  # a path it does not vary
+        self.assertEqual({r["eps"] for r in s.rows}, {0.05})
+
+    @unittest.skipUnless(RUNNER, "TSI_TEST_RUNNER not set")
+    def test_set_on_a_varied_path_is_refused_by_the_cli(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "study.json")
+            with open(path, "w") as f:
+                json.dump({"base": self.BASE, "vary": {"time.h": [0.25]}}, f)
+            cli = subprocess.run([RUNNER, "study", path, "--out", tmp, "--set", "time.h=0.5"], capture_output=True,
+                                 text=True)
+            self.assertEqual(cli.returncode, 2)
+            self.assertIn("--set time.h: the study varies this path", cli.stderr)
+
+    @unittest.skipUnless(RUNNER, "TSI_TEST_RUNNER not set")
+    def test_table_csv_has_a_column_per_varied_path(self):
+        spec = {"base": {"model": {"name": "nls", "eps": 0.1}, "reformulation": {"n_tau": 16},
+                         "time": {"h": 0.25, "t_end": 0.5}},
+                "vary": {"model.n_x": [8, 16]},
+                "cases": [{"label": "tol", "vary": {"scheme.tol": [1e-8, 1e-10]}},
+                          {"label": "anderson", "set": {"scheme": {"solver": "anderson"}}}]}
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "study.json")
+            with open(path, "w") as f:
+                json.dump(spec, f)
+            subprocess.run([RUNNER, "study", path, "--out", os.path.join(tmp, "o"), "--no-plots"], check=True,
+                           stdout=subprocess.DEVNULL)
+            with open(os.path.join(tmp, "o", "table.csv")) as f:
+                rows = list(csv.DictReader(f))
+        self.assertEqual(len(rows), 6)
+        for column in ("model.n_x", "scheme.tol", "scheme.solver"):
+            self.assertIn(column, rows[0])
+        self.assertEqual([r["model.n_x"] for r in rows], ["8", "8", "16", "16", "8", "16"])
+        self.assertEqual([r["scheme.solver"] for r in rows], ["", "", "", "", "anderson", "anderson"])
+
+    def test_an_unknown_model_mentions_plugins(self):
+        with self.assertRaises(tsi.ConfigError) as caught:
+            tsi.run(with_(HH, model={"name": "fput"}))
+        self.assertEqual(caught.exception.field, "model.name")
+        self.assertIn("--plugin FILE", str(caught.exception))
+        self.assertIn("tsi.load_plugin", str(caught.exception))
+
+
+class PythonModelTests(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        tsi.register_model("py-hh", HenonHeiles, n_tau=64, nonlinearity_degree=2,
+                           summary="Henon-Heiles written in Python")
+
+    def test_it_is_listed(self):
+        entry = [m for m in tsi.list("models") if m["name"] == "py-hh"]
+        self.assertEqual(len(entry), 1)
+
+    def test_errors_agree_with_the_cpp_model(self):
+        # The same scheme, eps and h with either model, measured against the C++ run's reference.
+        worst = 0.0
+        for scheme in ("se1", "se2", "fd", "me"):
+            for eps in (1.0, 0.01, 1 / 4096):
+                for h in (0.25, 0.0625):
+                    cfg = with_(HH, model={"eps": eps}, scheme={"name": scheme}, time={"h": h})
+                    cpp = tsi.run(cfg)
+                    cfg = with_(cfg, model={"name": "py-hh"})
+                    del cfg["reference"]
+                    py = tsi.run(cfg)
+                    self.assertEqual(py.status, "completed")
+                    self.assertEqual(py.config["reformulation"], cpp.config["reformulation"])
+                    error = np.linalg.norm(py.u_final - cpp.reference) / np.linalg.norm(cpp.reference)
+                    worst = max(worst, abs(error - cpp.error) / cpp.error)
+                    self.assertLess(abs(error - cpp.error), 1e-12, (scheme, eps, h))
+                    np.testing.assert_allclose(py.invariants["err_H"], cpp.invariants["err_H"], rtol=1e-6,
+                                               atol=1e-15)
+        print(f"\n  python vs C++ Henon-Heiles: largest relative difference of the errors {worst:.2e}")
+
+    def test_its_own_reference_agrees_too(self):
+        # The reference (rk78 on the filtered problem) computed with the Python model.
+        cpp = tsi.run(HH)
+        py = tsi.run(with_(HH, model={"name": "py-hh"}))
+        self.assertLess(abs(py.error - cpp.error), 1e-12)
+        np.testing.assert_allclose(py.reference, cpp.reference, rtol=0, atol=1e-13)
+
+    def test_cost_against_the_cpp_model(self):
+        cfg = with_(HH, time={"h": 1 / 64, "t_end": 1})
+        del cfg["reference"]
+        times = {}
+        for name in ("henon-heiles", "py-hh"):
+            runs = [tsi.run(with_(cfg, model={"name": name})) for _ in range(3)]
+            times[name] = min(r.wall_seconds for r in runs)
+        ratio = times["py-hh"] / times["henon-heiles"]
+        print(f"\n  se1, eps = 0.01, h = 1/64, T = 1: C++ {times['henon-heiles'] * 1e3:.2f} ms, "
+              f"python {times['py-hh'] * 1e3:.2f} ms, ratio {ratio:.1f}")
+        self.assertGreater(ratio, 1.0)
+
+    def test_a_python_exception_fails_the_run_with_its_message(self):
+        class Broken(HenonHeiles):
+            def filtered_field(self, taus, u):
+                raise ValueError("deliberately broken")
+
+        tsi.register_model("py-broken", Broken, nonlinearity_degree=2)
+        r = tsi.run(with_(HH, model={"name": "py-broken"}))
+        self.assertEqual(r.status, "failed")
+        self.assertIn("deliberately broken", r.message)
+        self.assertIn("filtered_field", r.message)
+
+    def test_a_wrong_shape_is_reported(self):
+        class Wrong(HenonHeiles):
+            def filtered_field(self, taus, u):
+                return super().filtered_field(taus, u)[:3]
+
+        tsi.register_model("py-wrong", Wrong, nonlinearity_degree=2)
+        r = tsi.run(with_(HH, model={"name": "py-wrong"}))
+        self.assertEqual(r.status, "failed")
+        self.assertIn("shape (3, 64), expected (4, 64)", r.message)
+
+    def test_parameters_reach_the_class_and_are_checked(self):
+        class Scaled(HenonHeiles):
+            def __init__(self, eps, scale):
+                super().__init__(eps)
+                self.scale = scale
+
+            def initial_value(self):
+                return super().initial_value() * self.scale
+
+        tsi.register_model("py-scaled", Scaled, params={"scale": 1.0}, nonlinearity_degree=2)
+        base = tsi.run(with_(HH, model={"name": "py-scaled"}))
+        half = tsi.run(with_(HH, model={"name": "py-scaled", "scale": 0.5}))
+        self.assertAlmostEqual(base.result["invariants"]["m"]["initial"],
+                               4 * half.result["invariants"]["m"]["initial"], delta=1e-15)
+        with self.assertRaises(tsi.ConfigError) as caught:
+            tsi.run(with_(HH, model={"name": "py-scaled", "scale": "big"}))
+        self.assertEqual(caught.exception.field, "model.scale")
+
+    def test_a_cpp_models_name_is_refused(self):
+        with self.assertRaises(tsi.PluginError):
+            tsi.register_model("henon-heiles", HenonHeiles)
+
+
+class InterruptTests(unittest.TestCase):
+    def test_sigint_stops_a_run_and_keeps_what_it_computed(self):
+        long_run = with_(HH, time={"h": 1 / 64, "t_end": 1e5})
+        del long_run["reference"]
+        timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+        start = time.monotonic()
+        timer.start()
+        with self.assertRaises(tsi.Interrupted) as caught:
+            tsi.run(long_run)
+        elapsed = time.monotonic() - start
+        r = caught.exception.result
+        self.assertIsInstance(caught.exception, KeyboardInterrupt)
+        self.assertEqual(r.status, "interrupted")
+        self.assertGreater(r.t_reached, 0.0)
+        self.assertLess(r.t_reached, 1e5)
+        self.assertEqual(len(r.t), r.steps + 1)
+        self.assertLess(elapsed, 5.0)
+        # The next run is not interrupted.
+        self.assertEqual(tsi.run(HH).status, "completed")
+
+
+@unittest.skipUnless(have("matplotlib"), "matplotlib not installed")
+class PlotTests(unittest.TestCase):
+    def lines(self, fig):
+        return [[(ax.get_title(), line.get_label(), np.asarray(line.get_xydata()).round(8).tolist())
+                 for line in ax.lines] for ax in fig.axes]
+
+    def check_same_as_the_script(self, spec, draw):
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from tsi import _plot_study
+
+        with tempfile.TemporaryDirectory() as tmp:
+            s = tsi.study(spec, jobs=2, out=tmp)
+            fig = draw(s)
+            with open(os.path.join(tmp, "table.csv")) as f:
+                rows = list(csv.DictReader(f))
+            if s.kind == "conservation":
+                script = _plot_study.conservation_figure(rows, s.title, _plot_study.read_runs(rows, tmp))
+            elif s.kind == "convergence":
+                script = _plot_study.convergence_figure(rows, s.title)
+            else:
+                script = _plot_study.work_precision_figure(rows, s.title)
+            self.assertEqual(self.lines(fig), self.lines(script))
+            self.assertGreater(sum(len(ax.lines) for ax in fig.axes), 0)
+            s.plot(tmp)
+            name = _plot_study.FILES[s.kind][0]
+            self.assertTrue(os.path.getsize(os.path.join(tmp, name)) > 1000)
+
+    def test_convergence(self):
+        self.check_same_as_the_script(StudyTests.SPEC, tsi.plot.convergence)
+
+    def test_conservation(self):
+        spec = {"kind": "conservation", "base": {"model": {"name": "hh", "eps": 0.1}, "time": {"t_end": 5}},
+                "vary": {"scheme.name": ["se1", "me"], "time.h": [0.5, 0.25]}}
+        self.check_same_as_the_script(spec, tsi.plot.conservation)
+
+    def test_work_precision(self):
+        spec = {"kind": "work-precision", "base": {"model": {"name": "hh", "eps": 1e-2}, "reference": {}},
+                "vary": {"scheme.name": ["se1"], "time.h": [0.5, 0.25, 0.125]}}
+        self.check_same_as_the_script(spec, tsi.plot.work_precision)
+
+    def test_the_wrong_kind_is_refused(self):
+        s = tsi.study({"kind": "conservation", "base": HH, "vary": {"time.h": [0.5]}}, jobs=1)
+        with self.assertRaises(ValueError):
+            tsi.plot.convergence(s)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
