@@ -361,7 +361,7 @@ int study_entry(PluginLoader& loader, Registry& registry, const StudyCli& cli) {
   const ShardSpec shard = cli.shard.empty() ? ShardSpec{} : parse_shard(cli.shard);
 #ifdef TSI_WITH_MPI
   if (mpi_launched()) {
-    if (!cli.shard.empty()) throw ConfigError("--shard", "cannot be combined with mpirun -np N (N > 1): use one or the other");
+    if (!cli.shard.empty()) throw ConfigError("--shard", "cannot be combined with mpirun: use one or the other");
     return mpi_study_command(loader, registry, cli);
   }
 #endif

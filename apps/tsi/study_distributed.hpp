@@ -50,7 +50,7 @@ void claim_study_dir(const std::string& out_dir, const Study& study);
 RunOutcome failed_run_outcome(const StudyRun& run, const std::string& message);
 
 #ifdef TSI_WITH_MPI
-/// Whether this process was started by mpirun (or another launcher) with more than one rank.
+/// Whether this process was started by mpirun (or another launcher), with any number of ranks.
 bool mpi_launched();
 /// The study over the ranks of MPI_COMM_WORLD (study_mpi.cpp). Every rank calls it.
 int mpi_study_command(PluginLoader& loader, Registry& registry, const StudyCli& cli);

@@ -436,7 +436,7 @@ class Master {
 bool mpi_launched() {
   for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "MPI_LOCALNRANKS"}) {
     const char* value = std::getenv(name);
-    if (value && std::atoi(value) > 1) return true;
+    if (value && std::atoi(value) >= 1) return true;
   }
   return false;
 }
