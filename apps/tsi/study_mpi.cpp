@@ -492,6 +492,7 @@ int mpi_study_command(PluginLoader& loader, Registry& registry, const StudyCli& 
     const double estimate = done ? elapsed * static_cast<double>(total - done) / static_cast<double>(done) : 0.0;
     fmt::print(stderr, "\r  {}/{} done, {:.1f} s elapsed, about {:.0f} s to go   ", done, total, elapsed, estimate);
   };
+  if (cli.jobs > 1) fmt::print(stderr, "tsi: note: --jobs is not used under mpirun; each rank runs one run at a time\n");
   if (tty) fmt::print(stderr, "  {} runs on {} MPI ranks\n", plan->study.runs.size(), ranks);
   std::vector<RunOutcome> outcomes;
   try {

@@ -28,6 +28,8 @@ TEST_CASE("study under mpirun -np 2: the table of --jobs 1, each run's files wri
              // which containers often forbid.
              {"OMPI_MCA_btl", "self,vader"}, {"OMPI_MCA_btl_vader_single_copy_mechanism", "none"},
              {"OMPI_MCA_rmaps_base_oversubscribe", "1"}, {"OMPI_MCA_hwloc_base_binding_policy", "none"}};
+  env.send_signal = SIGTERM;  // a guard: the study takes about a second; a hung mpirun is stopped
+  env.signal_after_seconds = 300.0;
   const auto mpi = run_command(TSI_TEST_MPIEXEC, {"-np", "2", "--oversubscribe", "--allow-run-as-root", TSI_TEST_RUNNER,
                                                   "study", study, "--out", dir / "mpi", "--no-plots"},
                                env);
