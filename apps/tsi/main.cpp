@@ -1,6 +1,7 @@
 // tsi: the runner. Wires model, reformulation and scheme together from a JSON config.
 //   tsi list [models|reformulations|schemes] [--json]
 //   tsi run CONFIG.json [--out DIR] [--set key.path=value ...]
+//   tsi study STUDY.json [--out DIR] [--jobs N] [--shard i/N]; tsi study --merge DIR... --out DIR
 // Exit codes: 0 success, 1 a run failed (its files are still written), 2 bad input.
 #include <fmt/format.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
@@ -20,6 +21,7 @@
 #include "run.hpp"
 #include "run_files.hpp"
 #include "study_command.hpp"
+#include "study_distributed.hpp"
 #include "summary.hpp"
 #include "tsi/error.hpp"
 #include "tsi/fft.hpp"
@@ -96,11 +98,16 @@ int main(int argc, char** argv) {
   int jobs = 0;
   bool no_plots = false;
   std::vector<std::string> study_overrides;
-  study->add_option("study", study_path, "the study file (JSON)")->required();
+  std::string shard;
+  std::vector<std::string> merge_dirs;
+  study->add_option("study", study_path, "the study file (JSON); absent with --merge");
   study->add_option("--out", study_out, "output directory (default: out/<study name>)");
   study->add_option("--jobs,-j", jobs, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   study->add_option("--set", study_overrides, "override a value of the base config: key.path=value");
   study->add_flag("--no-plots", no_plots, "do not call the plotting script");
+  study->add_option("--shard", shard, "run only shard i of N (i = 1..N) into --out; see --merge");
+  study->add_option("--merge", merge_dirs, "merge the output directories of all shards of a study into --out")
+      ->expected(1, -1);
 
   // tsi check [MODEL] [--plugin FILE] [--scheme NAME] [--eps EPS] (check_command.hpp)
   auto* check = app.add_subcommand("check", "run the conformance checks on a model or plugin");
@@ -149,7 +156,8 @@ int main(int argc, char** argv) {
     // exit code is then the shell's for that signal (128 + signal), after the files are on disk.
     tsi::app::install_interrupt_handlers();
     const int rc = study->parsed()
-                       ? tsi::app::study_command(loader, registry, study_path, study_out, jobs, study_overrides, !no_plots)
+                       ? tsi::app::study_entry(loader, registry,
+                                               {study_path, study_out, jobs, study_overrides, !no_plots, shard, merge_dirs})
                        : run_command(loader, registry, config_path, out_dir, overrides);
     if (tsi::app::interrupted()) {
       spdlog::error("interrupted by signal {}: what was computed is written", tsi::app::interrupt_signal());

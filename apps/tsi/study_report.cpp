@@ -282,6 +282,11 @@ Json work_at_error(const Json& rows, const std::vector<double>& targets) {
 void write_study_files(const std::string& dir, const Study& study, const std::vector<RunOutcome>& outcomes,
                        const Json& rows, double wall_seconds, int jobs) {
   for (size_t i = 0; i < study.runs.size(); ++i) write_run_files(dir + "/runs/" + study.runs[i].id, outcomes[i]);
+  write_study_table(dir, study, rows, wall_seconds, jobs);
+}
+
+void write_study_table(const std::string& dir, const Study& study, const Json& rows, double wall_seconds, int jobs,
+                       const Json& execution) {
   std::vector<std::string> extra;
   for (const auto& path : study.varied)
     if (!covered.count(path)) extra.push_back(path);
@@ -302,6 +307,7 @@ void write_study_files(const std::string& dir, const Study& study, const std::ve
               {"title", study.title}, {"machine", machine_json()}, {"jobs", jobs},
               {"wall_seconds", wall_seconds}, {"table", rows}};
   out["not_used"] = study.not_used;
+  for (const auto& [key, value] : execution.items()) out[key] = value;
   if (study.kind == "convergence") out["convergence"] = convergence_summary(rows);
   if (study.kind == "work-precision") out["work_at_error"] = work_at_error(rows, {1e-4, 1e-6});
   write_file_atomically(dir + "/study.json", out.dump(2) + "\n");

@@ -29,6 +29,12 @@ double drift_slope(const std::string& csv, const std::string& column, double t_f
 void write_study_files(const std::string& dir, const Study& study, const std::vector<RunOutcome>& outcomes,
                        const Json& rows, double wall_seconds, int jobs);
 
+/// Writes DIR/table.csv and DIR/study.json only (the run files are already in place: a merge
+/// of shards, or runs written by the MPI ranks that ran them). `execution` (an object) adds
+/// how the study was run to study.json, e.g. {"mpi_ranks": 4} or {"shards": 8}.
+void write_study_table(const std::string& dir, const Study& study, const Json& rows, double wall_seconds, int jobs,
+                       const Json& execution = Json::object());
+
 /// The tables printed on the terminal, by kind.
 std::string study_text(const Study& study, const Json& rows);
 
