@@ -25,6 +25,7 @@ EnergyRecord energy_error(const tsi::SchemeEntry& scheme) {
   auto two_scale = h.reformulation("two-scale", model,
                                    {{"n_tau", 64}, {"initial_data_order", std::max(1, tsi::default_traits(scheme).initial_data_order)}});
   auto stepper = h.scheme(scheme.info.name, tsi::Json::object(), "henon-heiles");
+  REQUIRE(stepper);
   const Vector u0 = model->initial_value();
   const double H0 = model->energy(u0);
   Vector y = two_scale->prepare(u0);
@@ -52,7 +53,12 @@ Drift drift(const EnergyRecord& r, double from) {
 TEST_CASE("long time: symmetric schemes conserve energy without drift, the others drift") {
   double symmetric_max = 0.0;
   std::vector<std::pair<std::string, double>> others;
-  for (const auto* scheme : tsi::test::second_order_schemes()) {
+  // Every two-scale scheme with its defaults: the paper's four, the symmetric compositions and
+  // collocation, and exponential Adams-Bashforth (which drifts). The 10x margin compares the
+  // second-order schemes only.
+  for (const auto* scheme : tsi::test::two_scale_schemes()) {
+    const tsi::StepperTraits traits = tsi::default_traits(*scheme);
+    const bool second_order = traits.order == 2 && traits.classical_order <= 2;
     const EnergyRecord record = energy_error(*scheme);
     const double max_err = *std::max_element(record.err_H.begin(), record.err_H.end());
     const Drift d = drift(record, 20.0);
@@ -64,10 +70,10 @@ TEST_CASE("long time: symmetric schemes conserve energy without drift, the other
     if (tsi::default_traits(*scheme).symmetric) {
       CHECK(max_err < 1e-3);
       CHECK(std::abs(d.over_window) < d.noise);  // no drift beyond the oscillation
-      symmetric_max = std::max(symmetric_max, max_err);
+      if (second_order) symmetric_max = std::max(symmetric_max, max_err);
     } else {
       CHECK(d.over_window > 10.0 * d.noise);  // a drift well above the oscillation
-      others.emplace_back(scheme->info.name, max_err);
+      if (second_order) others.emplace_back(scheme->info.name, max_err);
     }
   }
   REQUIRE(symmetric_max > 0.0);

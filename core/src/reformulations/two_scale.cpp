@@ -183,7 +183,9 @@ Matrix TwoScale::recursive_data(const Vector& v, double s) {
     Matrix candidate = next;
     candidate.col(0) += next_u;
     const double correction = (candidate - data).norm();
-    if (k > 2 && !(correction <= last_correction)) break;
+    // Growth at the rounding level is noise, not divergence: those corrections are kept.
+    const double rounding = 64.0 * std::numeric_limits<double>::epsilon() * data.norm();
+    if (k > 2 && !(correction <= std::max(last_correction, rounding))) break;
     last_correction = correction;
     data.swap(candidate);
     u = next_u;
