@@ -42,15 +42,20 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
   tsi::app::prepare_output_dir(out_dir);
 
   const bool tty = isatty(fileno(stderr));
-  const auto started = std::chrono::steady_clock::now();
-  auto progress = [&](double fraction) {
+  auto phase_started = std::chrono::steady_clock::now();
+  std::string phase;
+  auto progress = [&](double fraction, const char* what) {
     if (!tty) return;
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    if (phase != what) {  // each phase (run, reference, its check) has its own estimate
+      phase = what;
+      phase_started = std::chrono::steady_clock::now();
+    }
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - phase_started).count();
     if (fraction > 0.0)  // a run of hours says so within its first seconds
-      fmt::print(stderr, "\r  running: {:5.1f}%, {:.0f} s elapsed, about {:.0f} s to go   ", 100.0 * fraction, elapsed,
-                 elapsed * (1.0 - fraction) / fraction);
+      fmt::print(stderr, "\r  {}: {:5.1f}%, {:.0f} s elapsed, about {:.0f} s to go   ", what, 100.0 * fraction,
+                 elapsed, elapsed * (1.0 - fraction) / fraction);
     else
-      fmt::print(stderr, "\r  running: {:5.1f}%", 100.0 * fraction);
+      fmt::print(stderr, "\r  {}: {:5.1f}%", what, 100.0 * fraction);
   };
   const tsi::app::RunOutcome outcome = tsi::app::execute_run(config, registry, progress, nullptr, out_dir);
   if (tty) fmt::print(stderr, "\r{:80}\r", "");

@@ -86,7 +86,8 @@ namespace {
 
 // The reference's final state in model variables, with its scheme's tolerance scaled by
 // `tol_factor` and its substeps per fast period by `substep_factor`.
-Vector reference_model_state(const Json& config, const Registry& registry, double tol_factor, double substep_factor) {
+Vector reference_model_state(const Json& config, const Registry& registry, double tol_factor, double substep_factor,
+                             const ProgressFn& progress, const char* what) {
   const Json& ref = config["reference"];
   const SchemeEntry& scheme = registry.scheme(ref["scheme"], "reference.scheme");
   const Json scheme_section = reference_scheme_section(ref, scheme, tol_factor, substep_factor);
@@ -95,12 +96,20 @@ Vector reference_model_state(const Json& config, const Registry& registry, doubl
   const double t_end = config["time"]["t_end"];
   Vector y = a.reformulation->prepare(a.u0);
   if (t_end > 0.0) {
-    const double h = ref["h"].is_null() ? t_end : ref["h"].get<double>() / substep_factor;
+    // An adaptive reference goes in chunks of t_end / 256 (it chooses its substeps inside
+    // each): an interrupt stops it within one chunk, and a long one shows its progress.
+    constexpr long adaptive_chunks = 256;
+    const double h = ref["h"].is_null() ? t_end / adaptive_chunks : ref["h"].get<double>() / substep_factor;
     const long steps = std::max(1L, std::lround(t_end / h));
+    auto last_progress = Clock::now();
     integrate(*a.reformulation, *a.stepper, y, t_end / static_cast<double>(steps), steps,
-              [](long, double t, const Vector&) {
+              [&](long n, double t, const Vector&) {
                 if (interrupted())
                   throw Error(fmt::format("interrupted by signal {} at t = {:.6g}", interrupt_signal(), t));
+                if (progress && seconds_since(last_progress) > 0.5) {
+                  progress(static_cast<double>(n) / static_cast<double>(steps), what);
+                  last_progress = Clock::now();
+                }
                 return true;
               });
   }
@@ -122,18 +131,18 @@ double rounding_floor(const Model& model, const Vector& u) {
 
 }  // namespace
 
-ReferenceSolution compute_reference(const Json& config, const Registry& registry) {
+ReferenceSolution compute_reference(const Json& config, const Registry& registry, const ProgressFn& progress) {
   ReferenceSolution out;
   out.settings = config["reference"];
   const auto start = Clock::now();
-  const Vector u = reference_model_state(config, registry, 1.0, 1.0);  // its cost checked first
+  const Vector u = reference_model_state(config, registry, 1.0, 1.0, progress, "reference");  // its cost checked first
   std::shared_ptr<const Model> model =
       registry.model(config["model"]["name"]).create(Params(without_name(config["model"])));
   out.x = model->to_physical(u);
   out.wall_seconds = seconds_since(start);
   out.accuracy = std::numeric_limits<double>::quiet_NaN();
   if (out.settings.value("estimate_accuracy", true)) {
-    const Vector tighter = model->to_physical(reference_model_state(config, registry, 0.1, 2.0));
+    const Vector tighter = model->to_physical(reference_model_state(config, registry, 0.1, 2.0, progress, "reference check"));
     out.accuracy = std::max(model->error_norm(out.x - tighter) / model->error_norm(tighter),
                             rounding_floor(*model, u));
   }
@@ -225,7 +234,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
         return false;
       }
       if (progress && seconds_since(last_progress) > 0.5) {
-        progress(static_cast<double>(n) / static_cast<double>(std::max(1L, n_steps)));
+        progress(static_cast<double>(n) / static_cast<double>(std::max(1L, n_steps)), "run");
         last_progress = Clock::now();
       }
       return go_on;
@@ -280,7 +289,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   result["wall_seconds"] = wall;
 
   if (outcome.ok && config.contains("reference")) {
-    const ReferenceSolution ref = shared_reference ? *shared_reference : compute_reference(config, registry);
+    const ReferenceSolution ref = shared_reference ? *shared_reference : compute_reference(config, registry, progress);
     Json error = {{"relative", model->error_norm(x - ref.x) / model->error_norm(ref.x)},
                   {"absolute", model->error_norm(x - ref.x)},
                   {"reference", ref.settings}};

@@ -30,15 +30,17 @@ struct ReferenceSolution {
 /// than 1e8 steps: an adaptive solver's fast-period cap times t_end, or t_end / reference.h.
 void check_reference_cost(const Json& resolved, const Registry& registry);
 
+/// Called now and then with the fraction done of what is being computed ("run", or
+/// "reference" and "reference check" for the reference's two solves), for a progress line.
+using ProgressFn = std::function<void(double fraction, const char* what)>;
+
 /// Computes the reference solution a resolved config asks for ("reference" section).
-ReferenceSolution compute_reference(const Json& resolved, const Registry& registry);
+ReferenceSolution compute_reference(const Json& resolved, const Registry& registry, const ProgressFn& progress = {});
 
 /// What identifies a reference: the model section, t_end and the reference section. Runs
 /// with equal keys share one reference.
 std::string reference_key(const Json& resolved);
 
-/// Called now and then with the fraction done, for a progress line.
-using ProgressFn = std::function<void(double fraction)>;
 
 /// Runs a resolved config (resolve_run_config): builds model, reformulation and scheme from
 /// the registry, integrates, records the invariants, and compares with the reference when
