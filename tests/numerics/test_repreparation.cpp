@@ -107,6 +107,44 @@ TEST_CASE("re-preparation: NLS at eps = 0.1 keeps its mass over T = 200 where th
   CHECK(automatic < 1e-3);  // measured 1.9e-4
 }
 
+TEST_CASE("re-preparation: auto brings the charged particle at eps = 1 below 1e-3 and leaves NLS at eps = 0.01 alone") {
+  // The largest relative change of H over T = 200, plain and auto (with auto's default data of
+  // order 4), through the same assembler as tsi run.
+  auto max_energy_error = [](const std::string& model, const std::string& scheme, double eps, double h,
+                             const Json& rule, long* repreparations) {
+    auto a = Harness::instance().assemble(config(model, scheme, eps, rule));
+    Vector y = a.reformulation->prepare(a.u0);
+    const double e0 = a.model->energy(a.u0);
+    double worst = 0.0;
+    const long steps = std::lround(200.0 / h);
+    tsi::integrate(*a.reformulation, *a.stepper, y, h, steps, [&](long, double t, const Vector& state) {
+      worst = std::max(worst, std::abs(a.model->energy(a.reformulation->read_back(state, t)) - e0) / std::abs(e0));
+      return std::isfinite(worst) && worst < 10.0;
+    });
+    *repreparations = static_cast<long>(a.reformulation->repreparation_times().size());
+    return worst;
+  };
+  long count = 0;
+  for (const char* scheme : {"se1", "se2"}) {
+    CAPTURE(std::string(scheme));
+    const double never = max_energy_error("cpd", scheme, 1.0, 0.2, "never", &count);
+    const double automatic = max_energy_error("cpd", scheme, 1.0, 0.2, "auto", &count);
+    CAPTURE(never);
+    CAPTURE(automatic);
+    CHECK(never > 0.1);        // measured 0.42 (SE1), SE2 blows up at t = 128
+    CHECK(automatic < 1e-3);   // measured 6.4e-4, 7.7e-4
+    CHECK(count > 10);         // measured 94, 95
+  }
+  // NLS at eps = 0.01: U's distance from its prepared data is the scheme's own O(h^2) error;
+  // the floor keeps auto from acting on it (without: 9x the plain err_H).
+  const double never = max_energy_error("nls", "se1", 0.01, 0.125, "never", &count);
+  const double automatic = max_energy_error("nls", "se1", 0.01, 0.125, "auto", &count);
+  CAPTURE(never);
+  CAPTURE(automatic);
+  CHECK(count == 0);
+  CHECK(automatic <= 1.5 * never);
+}
+
 TEST_CASE("re-preparation: every model keeps its order at T = 1 in its declared regime, every step and auto") {
   // Second order is kept everywhere. The error may grow by a bounded factor: each re-preparation
   // restarts the scheme (ME then takes its start-up step every step: 1.85 times the plain error

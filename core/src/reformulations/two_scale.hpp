@@ -16,6 +16,7 @@ struct Repreparation {
   /// Auto: re-prepare when U's distance from the prepared data at its own diagonal value,
   /// |U - P(v_n, s_n)|, exceeds this fraction of P's own tau variation |P - mean P|.
   double defect = 0.1;
+  double defect_floor = 1e-4;  ///< Auto: defects below this fraction of |U| never trigger
   long min_gap = 10;  ///< Auto: tested (one evaluation of r1) every this many steps
 };
 
