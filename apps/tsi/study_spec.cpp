@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <sstream>
 
 #include "config.hpp"
 #include "tsi/error.hpp"
@@ -41,9 +42,11 @@ void leaf_paths(const std::string& prefix, const Json& value, std::vector<std::s
 }
 
 Json::json_pointer pointer(const std::string& dotted) {
-  std::string p = "/" + dotted;
-  std::replace(p.begin(), p.end(), '.', '/');
-  return Json::json_pointer(p);
+  // Token by token: a key may hold '~' or '/', which a pointer's text would read as escapes.
+  Json::json_pointer p;
+  std::stringstream ss(dotted);
+  for (std::string key; std::getline(ss, key, '.');) p /= key;
+  return p;
 }
 
 // A string entry of a study object, or `fallback` when absent.
@@ -129,7 +132,8 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
         study.varied.push_back(path);
     auto lists = common;
     for (auto& [path, values] : vary_lists(one.value("vary", Json::object()), where + ".vary")) {
-      auto it = std::find_if(lists.begin(), lists.end(), [&](const auto& p) { return p.first == path; });
+      const std::string& name = path;  // (clang 14 cannot capture a structured binding)
+      auto it = std::find_if(lists.begin(), lists.end(), [&](const auto& p) { return p.first == name; });
       if (it != lists.end()) it->second = values; else lists.emplace_back(path, values);
     }
     for (const auto& [path, values] : lists)
