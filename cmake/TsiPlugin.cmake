@@ -32,7 +32,8 @@ function(tsi_add_plugin name)
   set_target_properties(${target} PROPERTIES PREFIX "" OUTPUT_NAME tsi_${name}
                         CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON
                         POSITION_INDEPENDENT_CODE ON)
-  if(CMAKE_SYSTEM_NAME STREQUAL "Linux")
+  # (not in the fuzzing build: clang's sanitizer runtime is in the executable, not the plugin)
+  if(CMAKE_SYSTEM_NAME STREQUAL "Linux" AND NOT TSI_BUILD_FUZZERS)
     target_link_options(${target} PRIVATE "LINKER:--no-undefined")
   endif()
   # sqrt and friends need not set errno (nothing reads it), so loops over tau points that

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -117,8 +118,12 @@ Json parse_json(std::istream& in, const std::string& origin) {
     }
     return true;
   };
+  // The parser takes a NUL byte for the end of the input and would ignore what follows it.
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (const auto nul = text.find('\0'); nul != std::string::npos)
+    throw ConfigError(origin, fmt::format("malformed JSON: a NUL byte at offset {}; a config is a text file", nul));
   try {
-    return Json::parse(in, check, true, /*ignore_comments=*/true);
+    return Json::parse(text, check, true, /*ignore_comments=*/true);
   } catch (const Json::parse_error& e) {
     throw ConfigError(origin, std::string("malformed JSON: ") + e.what());
   } catch (const Json::out_of_range&) {

@@ -75,6 +75,10 @@ int main(int argc, char** argv) {
   spdlog::set_pattern("tsi: %^%l%$: %v");
 
   CLI::App app{"tsi: uniformly accurate two-scale integrators for highly oscillatory systems"};
+  // Command-line mistakes read like every other bad input: "tsi: error: --OPTION: message".
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return "tsi: error: " + std::string(e.what()) + "\nRun with --help for more information.\n";
+  });
   app.require_subcommand(1);
   app.set_version_flag("--version", tsi::version_string);
   std::vector<std::string> plugin_files;

@@ -180,6 +180,13 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   const SchemeEntry& scheme_entry = *assembly.scheme_entry;
   std::shared_ptr<const Model> model = assembly.model;
   const Vector u0 = assembly.u0;
+  {  // an initial value whose invariants overflow (entries of 1e300) would only "blow up" at t = 0
+    const double H0 = model->energy(u0), I0 = model->oscillatory_energy(u0), m0 = model->mass(u0);
+    if (!u0.allFinite() || !std::isfinite(H0) || !std::isfinite(I0) || !std::isfinite(m0))
+      throw ConfigError("model.u0", fmt::format("H = {}, I = {}, m = {} at the initial value; expected an initial "
+                                                "value whose invariants are finite numbers",
+                                                H0, I0, m0));
+  }
   Reformulation* reformulation = assembly.reformulation.get();
   Stepper* stepper = assembly.stepper.get();
 

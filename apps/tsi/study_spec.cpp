@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <sstream>
 
 #include "config.hpp"
 #include "tsi/error.hpp"
@@ -41,9 +42,20 @@ void leaf_paths(const std::string& prefix, const Json& value, std::vector<std::s
 }
 
 Json::json_pointer pointer(const std::string& dotted) {
-  std::string p = "/" + dotted;
-  std::replace(p.begin(), p.end(), '.', '/');
-  return Json::json_pointer(p);
+  // Token by token: a key may hold '~' or '/', which a pointer's text would read as escapes.
+  Json::json_pointer p;
+  std::stringstream ss(dotted);
+  for (std::string key; std::getline(ss, key, '.');) p /= key;
+  return p;
+}
+
+// A string entry of a study object, or `fallback` when absent.
+std::string string_entry(const Json& object, const std::string& key, const std::string& fallback,
+                         const std::string& where) {
+  if (!object.contains(key)) return fallback;
+  const Json& v = object.at(key);
+  if (!v.is_string()) throw ConfigError(where, "got " + v.dump() + ", expected a string");
+  return v.get<std::string>();
 }
 
 bool is_unknown_parameter(const ConfigError& e) {
@@ -59,10 +71,10 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
       throw ConfigError(key, "unknown study key; valid keys are: base, cases, kind, title, vary");
   Study study;
   study.spec = spec;
-  study.kind = spec.value("kind", std::string("convergence"));
+  study.kind = string_entry(spec, "kind", "convergence", "kind");
   if (std::find(kinds.begin(), kinds.end(), study.kind) == kinds.end())
     throw ConfigError("kind", "got \"" + study.kind + "\", expected one of: convergence, conservation, work-precision");
-  study.title = spec.value("title", std::string());
+  study.title = string_entry(spec, "title", "", "title");
   if (!spec.contains("base") || !spec["base"].is_object())
     throw ConfigError("base", "missing or not an object; it is the run config every run starts from");
   Json base = spec["base"];
@@ -70,6 +82,10 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
   Json cases = spec.value("cases", Json::array({Json::object()}));
   if (!cases.is_array() || cases.empty()) throw ConfigError("cases", "expected a non-empty list of cases");
 
+  for (const auto& assignment : overrides) {  // its syntax first: "--set time.h" lacks a value
+    Json scratch = Json::object();
+    apply_override(scratch, assignment);
+  }
   // A --set on a path the study varies (or a case sets) would be silently replaced: refused.
   for (const auto& assignment : overrides) {
     const std::string path = assignment.substr(0, assignment.find('='));
@@ -99,6 +115,10 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
     const Json& one = cases[c];
     const std::string where = fmt::format("cases[{}]", c);
     if (!one.is_object()) throw ConfigError(where, "got " + one.dump() + ", expected an object");
+    for (const auto& [key, value] : one.items())
+      if (key != "label" && key != "set" && key != "vary")
+        throw ConfigError(where + "." + key, "unknown key of a case; valid keys are: label, set, vary");
+    const std::string label = string_entry(one, "label", "", where + ".label");
     Json config = base;
     const Json set = one.value("set", Json::object());  // a named copy: items() must not outlive it
     if (!set.is_object()) throw ConfigError(where + ".set", "got " + set.dump() + ", expected an object of path: value");
@@ -112,7 +132,8 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
         study.varied.push_back(path);
     auto lists = common;
     for (auto& [path, values] : vary_lists(one.value("vary", Json::object()), where + ".vary")) {
-      auto it = std::find_if(lists.begin(), lists.end(), [&](const auto& p) { return p.first == path; });
+      const std::string& name = path;  // (clang 14 cannot capture a structured binding)
+      auto it = std::find_if(lists.begin(), lists.end(), [&](const auto& p) { return p.first == name; });
       if (it != lists.end()) it->second = values; else lists.emplace_back(path, values);
     }
     for (const auto& [path, values] : lists)
@@ -132,7 +153,7 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
     for (bool done = false; !done;) {
       StudyRun run;
       run.id = fmt::format("r{:04d}", study.runs.size() + 1);
-      run.label = one.value("label", std::string());
+      run.label = label;
       run.assignments = Json::object();
       Json raw = config;
       for (const auto& path : set_paths)

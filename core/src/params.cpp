@@ -156,9 +156,8 @@ Json resolve_params(const ParamSchema& schema, const Json& given, const std::str
     }
     if (value.is_null()) continue;  // explicit null: the default applies
     const std::string wanted = spec->expected.empty() ? describe(spec->type) : spec->expected;
-    const auto reject = [&] {
-      return ConfigError(join_path(path, key), "got " + value.dump() + ", expected " + wanted);
-    };
+    const std::string field = join_path(path, key), got = value.dump();  // (clang 14 cannot capture bindings)
+    const auto reject = [&] { return ConfigError(field, "got " + got + ", expected " + wanted); };
     if (!has_type(spec->type, value)) throw reject();
     Json v = (spec->type == ParamType::Integer && value.is_number_float())
                  ? Json(static_cast<long>(value.get<double>()))

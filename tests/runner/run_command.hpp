@@ -35,6 +35,7 @@ inline bool contains(const std::string& text, const std::string& part) { return 
 struct CommandResult {
   int exit_code = -1;  ///< the exit status, or -1 when the process died of a signal
   int signal = 0;      ///< the signal that ended it, 0 when it exited normally
+  bool timed_out = false;  ///< killed (SIGKILL) after CommandEnv::timeout_seconds
   std::string out;     ///< everything written to stdout
   std::string err;     ///< everything written to stderr
 
@@ -55,6 +56,7 @@ struct CommandEnv {
   std::vector<std::string> unset;          ///< variables to remove
   int send_signal = 0;                     ///< a signal to send the child (0: none) ...
   double signal_after_seconds = 0.0;       ///< ... this long after it started
+  double timeout_seconds = 0.0;            ///< kill the child (SIGKILL) after this long (0: never)
 };
 
 namespace detail {
@@ -137,7 +139,13 @@ inline CommandResult run_command(const std::string& program, const std::vector<s
       ::kill(pid, env.send_signal);
       signalled = true;
     }
-    if (::poll(polls, 2, signalled ? -1 : 20) < 0) {
+    if (env.timeout_seconds > 0.0 && !result.timed_out &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() >= env.timeout_seconds) {
+      ::kill(pid, SIGKILL);
+      result.timed_out = true;
+    }
+    const bool watching = !signalled || (env.timeout_seconds > 0.0 && !result.timed_out);
+    if (::poll(polls, 2, watching ? 20 : -1) < 0) {
       if (errno == EINTR) continue;
       break;
     }
