@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "interrupt.hpp"
+#include "tsi/error.hpp"
 #include "tsi/fft.hpp"
 #include "tsi/version.hpp"
 
@@ -77,6 +78,12 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
   parallel_for(study.runs.size(), jobs, [&](size_t i) {
     const StudyRun& run = study.runs[i];
     const ReferenceSolution* reference = nullptr;
+    if (interrupted()) {  // not started (its reference may have been cut short too): the study was interrupted
+      outcomes[i] = failed_outcome(run, fmt::format("not run: the study was interrupted by signal {}", interrupt_signal()));
+      outcomes[i].result["status"] = "interrupted";
+      tick();
+      return;
+    }
     if (run.config.contains("reference")) {
       const size_t r = reference_index.at(reference_key(run.config));
       if (!reference_errors[r].empty()) {
@@ -86,15 +93,12 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
       }
       reference = &references[r];
     }
-    if (interrupted()) {  // not started: the study was interrupted
-      outcomes[i] = failed_outcome(run, fmt::format("not run: the study was interrupted by signal {}", interrupt_signal()));
-      outcomes[i].result["status"] = "interrupted";
-      tick();
-      return;
-    }
     try {
       outcomes[i] = execute_run(run.config, registry, {}, reference,
                                 out_dir.empty() ? std::string() : out_dir + "/runs/" + run.id);
+    } catch (const IoError& e) {  // its output directory could not be made or written
+      outcomes[i] = failed_outcome(run, e.what());
+      outcomes[i].io_error = e.what();
     } catch (const std::exception& e) {
       outcomes[i] = failed_outcome(run, e.what());
     }
