@@ -3,7 +3,9 @@
 // memory of a long run with output every step (constant in its length).
 #include <doctest/doctest.h>
 
+#include <chrono>
 #include <cstdlib>
+#include <thread>
 #include <string>
 #include <vector>
 
@@ -164,6 +166,25 @@ TEST_CASE("full disk: when result.json itself cannot be written, no partial file
   CHECK_FALSE(t::fs::exists(dir.path() / "out" / "result.json"));
   CHECK(check_valid_csv(dir.path() / "out" / "invariants.csv") == 5);
   check_no_temporaries(dir.path() / "out");
+}
+
+TEST_CASE("unwritable output: --out removed mid-run gives exit code 3 naming the file, and result.json") {
+  t::TempDir dir;
+  const std::string out = dir / "out";
+  const std::string config = t::write_config(dir, long_hh_config(300000));  // about 1.5 s
+  std::thread remover([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    std::error_code ec;
+    t::fs::remove_all(out, ec);
+  });
+  const t::CommandResult r = t::run_tsi({"run", config, "--out", out});
+  remover.join();
+  INFO(r.describe());
+  CHECK(r.signal == 0);
+  CHECK(r.exit_code == 3);
+  CHECK(t::contains(r.err, "tsi: error: cannot rename " + out + "/invariants.csv.partial to " + out +
+                               "/invariants.csv: No such file or directory"));
+  CHECK(t::read_json(t::fs::path(out) / "result.json").at("steps") == 300000);
 }
 
 TEST_CASE("full disk: a study keeps every run's result.json and its table, and exits with 3") {
