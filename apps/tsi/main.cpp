@@ -1,7 +1,7 @@
 // tsi: the runner. Wires model, reformulation and scheme together from a JSON config.
 //   tsi list [models|reformulations|schemes] [--json]
-//   tsi run CONFIG.json [--out DIR] [--set key.path=value ...]
-//   tsi study STUDY.json [--out DIR] [--jobs N] [--shard i/N]; tsi study --merge DIR... --out DIR
+//   tsi run CONFIG.json [--out DIR] [--set key.path=value ...] [--max-steps N]
+//   tsi study STUDY.json [--out DIR] [--jobs N] [--shard i/N] [--max-steps N]; tsi study --merge DIR... --out DIR
 // Exit codes: 0 success, 1 a run failed (its files are still written), 2 bad input, 3 an output
 // could not be written (what could be is kept valid), 128 + N interrupted by signal N.
 #include <fmt/format.h>
