@@ -1,8 +1,9 @@
 // tsi: the runner. Wires model, reformulation and scheme together from a JSON config.
 //   tsi list [models|reformulations|schemes] [--json]
-//   tsi run CONFIG.json [--out DIR] [--set key.path=value ...]
-//   tsi study STUDY.json [--out DIR] [--jobs N] [--shard i/N]; tsi study --merge DIR... --out DIR
-// Exit codes: 0 success, 1 a run failed (its files are still written), 2 bad input.
+//   tsi run CONFIG.json [--out DIR] [--set key.path=value ...] [--max-steps N]
+//   tsi study STUDY.json [--out DIR] [--jobs N] [--shard i/N] [--max-steps N]; tsi study --merge DIR... --out DIR
+// Exit codes: 0 success, 1 a run failed (its files are still written), 2 bad input, 3 an output
+// could not be written (what could be is kept valid), 128 + N interrupted by signal N.
 #include <fmt/format.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -38,6 +39,9 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
   if (raw.is_object() && raw.contains("plugins"))
     tsi::app::load_config_plugins(loader, raw["plugins"], config_path);
   const Json config = tsi::app::resolve_run_config(raw, registry);
+  // Too many steps are refused before --out is touched; the reference's cost after the run's
+  // own objects are checked (their memory first), still before anything is computed.
+  tsi::app::check_run_steps(config);
   if (out_dir.empty()) out_dir = "out/" + std::filesystem::path(config_path).stem().string();
   tsi::app::prepare_output_dir(out_dir);
 
@@ -59,8 +63,12 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
   };
   const tsi::app::RunOutcome outcome = tsi::app::execute_run(config, registry, progress, nullptr, out_dir);
   if (tty) fmt::print(stderr, "\r{:80}\r", "");
-  tsi::app::write_run_files(out_dir, outcome);
+  tsi::app::write_run_files(out_dir, outcome);  // IoError (exit 3) when result.json cannot be written
   fmt::print("{}", tsi::app::run_summary(outcome, out_dir));
+  if (!outcome.io_error.empty()) {  // the run's own files are written as far as they could be
+    spdlog::error("{}", outcome.message);
+    return 3;
+  }
   if (!outcome.ok) {
     spdlog::error("run {}: {}", outcome.result.value("status", std::string("failed")), outcome.message);
     return 1;
@@ -101,6 +109,10 @@ int main(int argc, char** argv) {
   run->add_option("config", config_path, "the run config (JSON)")->required();
   run->add_option("--out", out_dir, "output directory (default: out/<config name>)");
   run->add_option("--set", overrides, "override a config value: key.path=value (repeatable)");
+  double max_steps = tsi::app::default_max_steps;
+  const std::string max_steps_help =
+      "refuse a run (or its reference) estimated to take more than N steps, before it starts (default 1e9)";
+  run->add_option("--max-steps", max_steps, max_steps_help);
 
   auto* study = app.add_subcommand("study", "run a study (a base config and lists of values) in parallel");
   std::string study_path, study_out;
@@ -114,6 +126,7 @@ int main(int argc, char** argv) {
   study->add_option("--jobs,-j", jobs, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   study->add_option("--set", study_overrides, "override a value of the base config: key.path=value");
   study->add_flag("--no-plots", no_plots, "do not call the plotting script");
+  study->add_option("--max-steps", max_steps, max_steps_help + " (each run)");
   study->add_option("--shard", shard, "run only shard i of N (i = 1..N) into --out; see --merge");
   study->add_option("--merge", merge_dirs, "merge the output directories of all shards of a study into --out")
       ->expected(1, -1);
@@ -139,6 +152,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  // A run or study stops at its next step on SIGINT or SIGTERM and writes what it has; the
+  // exit code is then the shell's for that signal (128 + signal), after the files are on disk.
+  // Installed before anything is read, so that a signal at any moment of a run is kept.
+  if (run->parsed() || study->parsed()) tsi::app::install_interrupt_handlers();
 
   try {
     tsi::set_fft_threads(fft_threads, 65536);
@@ -161,18 +178,19 @@ int main(int argc, char** argv) {
       check_options.model_params = model_overrides["model"];
       return tsi::app::check_command(loader, registry, check_options, plugin_files);
     }
-    // A run or study stops at its next step on SIGINT or SIGTERM and writes what it has; the
-    // exit code is then the shell's for that signal (128 + signal), after the files are on disk.
-    tsi::app::install_interrupt_handlers();
+    tsi::app::set_max_steps(max_steps);
     const int rc = study->parsed()
                        ? tsi::app::study_entry(loader, registry,
                                                {study_path, study_out, jobs, study_overrides, !no_plots, shard, merge_dirs})
                        : run_command(loader, registry, config_path, out_dir, overrides);
-    if (tsi::app::interrupted()) {
+    if (tsi::app::interrupted() && rc != 3) {  // an output that failed is said first
       spdlog::error("interrupted by signal {}: what was computed is written", tsi::app::interrupt_signal());
       return 128 + tsi::app::interrupt_signal();
     }
     return rc;
+  } catch (const tsi::IoError& e) {  // an output could not be written: not the input's fault
+    spdlog::error("{}", e.what());
+    return 3;
   } catch (const tsi::Error& e) {
     spdlog::error("{}", e.what());
     return 2;

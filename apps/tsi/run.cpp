@@ -51,29 +51,64 @@ Assembly reference_assembly(const Json& config, const Registry& registry, const 
                          registry);
 }
 
-// What the reference will cost, refused before it starts when it cannot finish: an adaptive
-// solver takes at least substeps_per_period steps per fastest period of the problem.
+// What the reference will cost, refused before it starts when it would exceed --max-steps: an
+// adaptive solver takes at least substeps_per_period steps per fastest period of the problem.
 void check_reference_cost(const Json& config, const Assembly& a, const Json& scheme_section) {
   const Json& ref = config["reference"];
   const double t_end = config["time"]["t_end"];
-  constexpr double max_reference_steps = 1e8;  // hours of work for the cheapest solver
+  const double limit = max_steps();
   const double period = a.reformulation->fast_period();
-  if (scheme_section.contains("substeps_per_period") && period > 0.0 &&
-      t_end / period * scheme_section["substeps_per_period"].get<double>() > max_reference_steps)
-    throw ConfigError("reference", fmt::format("{} on the {} problem would take at least {:.3g} steps ({} per fast "
-                                               "period 2 pi eps / {:g}); use a two-scale reference, e.g. "
-                                               "{{\"scheme\": \"se2\", \"reformulation\": \"two-scale\", \"h\": {}}}",
-                                               a.scheme_entry->info.name, ref["reformulation"].get<std::string>(),
-                                               t_end / period * scheme_section["substeps_per_period"].get<double>(),
-                                               scheme_section["substeps_per_period"].get<double>(),
-                                               a.model->max_linear_frequency(), t_end / 4096));
-  if (!ref["h"].is_null() && t_end / ref["h"].get<double>() > max_reference_steps)
-    throw ConfigError("reference.h", fmt::format("got {}: {:.3g} steps over t_end = {}; at most {:.0e}",
-                                                 ref["h"].get<double>(), t_end / ref["h"].get<double>(), t_end,
-                                                 max_reference_steps));
+  if (scheme_section.contains("substeps_per_period") && period > 0.0) {
+    const double substeps = scheme_section["substeps_per_period"].get<double>();
+    const double estimate = t_end / period * substeps;  // in double: 1e300 with eps = 1e-300
+    if (!(estimate <= limit))
+      throw ConfigError("reference", fmt::format("{} on the {} problem would take at least {:.3g} steps ({} per fast "
+                                                 "period 2 pi eps / {:g}), more than --max-steps = {:.3g}; use a "
+                                                 "two-scale reference, e.g. {{\"scheme\": \"se2\", \"reformulation\": "
+                                                 "\"two-scale\", \"h\": {}}}, or raise the limit with --max-steps N",
+                                                 a.scheme_entry->info.name, ref["reformulation"].get<std::string>(),
+                                                 estimate, substeps, a.model->max_linear_frequency(), limit,
+                                                 t_end / 4096));
+  }
+  if (!ref["h"].is_null()) {
+    const double estimate = t_end / ref["h"].get<double>();
+    if (!(estimate <= limit))
+      throw ConfigError("reference.h", fmt::format("got {}: {:.3g} steps over t_end = {}; at most {:.3g} "
+                                                   "(--max-steps; raise the limit with --max-steps N)",
+                                                   ref["h"].get<double>(), estimate, t_end, limit));
+  }
 }
 
 }  // namespace
+
+namespace {
+double max_steps_limit = default_max_steps;
+}  // namespace
+
+void set_max_steps(double limit) {
+  if (!(limit >= 1.0 && limit <= 1e12))
+    throw ConfigError("--max-steps", fmt::format("got {}, expected a number of steps from 1 to 1e12 (beyond "
+                                                 "1e12, t_end / h is refused whatever the limit)",
+                                                 limit));
+  max_steps_limit = limit;
+}
+
+double max_steps() { return max_steps_limit; }
+
+void check_run_steps(const Json& config) {
+  const double h = config["time"]["h"], t_end = config["time"]["t_end"];
+  const double estimate = t_end / h;  // in double: t_end / h may be 1e300, far beyond a long
+  if (!(estimate <= max_steps()))
+    throw ConfigError("time.h", fmt::format("got {}: the run would take {:.3g} steps (t_end = {} / h), more than "
+                                            "--max-steps = {:.3g}; choose a larger time.h or a smaller time.t_end, "
+                                            "or raise the limit with --max-steps N",
+                                            h, estimate, t_end, max_steps()));
+}
+
+void check_work_estimate(const Json& config, const Registry& registry) {
+  check_run_steps(config);
+  if (config.contains("reference")) check_reference_cost(config, registry);
+}
 
 void check_reference_cost(const Json& config, const Registry& registry) {
   const Json& ref = config["reference"];
@@ -176,6 +211,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   // that propagates before anything runs.
   Assembly assembly = assemble(config, registry);
   // A reference that could not finish is refused now, not after the run.
+  check_run_steps(config);
   if (config.contains("reference") && !shared_reference) check_reference_cost(config, registry);
   const SchemeEntry& scheme_entry = *assembly.scheme_entry;
   std::shared_ptr<const Model> model = assembly.model;
@@ -215,7 +251,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   if (!stream_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(stream_dir, ec);
-    if (ec) throw Error("cannot create " + stream_dir + ": " + ec.message());
+    if (ec) throw IoError("cannot create " + stream_dir + ": " + ec.message());
     outcome.csv_file = stream_dir + "/invariants.csv.partial";
   }
   RunRecorder recorder(*model, *reformulation, u0, config, outcome.csv_file);
@@ -250,10 +286,28 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
       status = recorder.status();
       outcome.message = recorder.message();
     }
+  } catch (const IoError& e) {  // the output failed (a full disk), not the computation
+    status = "failed";
+    outcome.io_error = e.what();
   } catch (const std::exception& e) {
     status = "failed";
     outcome.message = fmt::format("at t = {:.6g} (step {}): {}", step_time(recorder.steps(), h),
                                   recorder.steps() + 1, e.what());
+  }
+  if (outcome.io_error.empty()) {
+    try {
+      recorder.finish_csv();
+    } catch (const IoError& e) {
+      status = "failed";
+      outcome.io_error = e.what();
+    }
+  }
+  if (!outcome.io_error.empty()) {
+    const double kept = recorder.csv_written_to();
+    outcome.message = fmt::format("{}: the run stopped at t = {:.6g} (step {}); invariants.csv keeps {}",
+                                  outcome.io_error, recorder.t_reached(), recorder.steps(),
+                                  std::isnan(kept) ? std::string("its header only")
+                                                   : fmt::format("the rows up to t = {:.6g}", kept));
   }
   const double wall = seconds_since(start);
 
@@ -296,7 +350,21 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   result["wall_seconds"] = wall;
 
   if (outcome.ok && config.contains("reference")) {
-    const ReferenceSolution ref = shared_reference ? *shared_reference : compute_reference(config, registry, progress);
+    ReferenceSolution ref;
+    try {
+      ref = shared_reference ? *shared_reference : compute_reference(config, registry, progress);
+    } catch (const ConfigError&) {
+      throw;
+    } catch (const std::exception& e) {
+      // The run's own results are kept: an interrupt (or a failure) of its reference only
+      // leaves the error out.
+      outcome.ok = false;
+      result["status"] = interrupted() ? "interrupted" : "failed";
+      outcome.message = fmt::format("{} the reference solution: {} (the run itself completed: its results are kept)",
+                                    interrupted() ? "interrupted while computing" : "failed computing", e.what());
+      result["message"] = outcome.message;
+      return outcome;
+    }
     Json error = {{"relative", model->error_norm(x - ref.x) / model->error_norm(ref.x)},
                   {"absolute", model->error_norm(x - ref.x)},
                   {"reference", ref.settings}};

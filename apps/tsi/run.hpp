@@ -14,6 +14,7 @@ struct RunOutcome {
   std::string csv_file;  ///< where its rows were streamed as they were computed (empty: in csv)
   bool ok = true;
   std::string message;  ///< why the run failed (empty when ok)
+  std::string io_error;  ///< an output that could not be written (IoError: exit code 3); empty otherwise
 };
 
 /// The reference solution at t_end (physical variables) and how good it is.
@@ -26,9 +27,24 @@ struct ReferenceSolution {
   Json settings;  ///< the resolved reference section
 };
 
+/// The most steps a run (t_end / time.h) or its reference may take unless --max-steps says
+/// otherwise: generous (hours of work for the cheapest scheme), but a typo's 1e12 is refused.
+inline constexpr double default_max_steps = 1e9;
+/// Sets the limit (tsi run/study --max-steps); a ConfigError naming --max-steps below 1.
+void set_max_steps(double limit);
+double max_steps();
+
+/// Refuses (ConfigError naming time.h) a run whose t_end / h exceeds max_steps(), with the
+/// estimate and how to lift the limit; computed in double, before anything is narrowed.
+void check_run_steps(const Json& resolved);
+
 /// Refuses (ConfigError naming reference or reference.h) a reference that would take more
-/// than 1e8 steps: an adaptive solver's fast-period cap times t_end, or t_end / reference.h.
+/// than max_steps() steps: an adaptive solver's fast-period cap times t_end, or t_end / reference.h.
 void check_reference_cost(const Json& resolved, const Registry& registry);
+
+/// The work estimate of a run before it starts: check_run_steps, and check_reference_cost
+/// when it has a reference.
+void check_work_estimate(const Json& resolved, const Registry& registry);
 
 /// Called now and then with the fraction done of what is being computed ("run", or
 /// "reference" and "reference check" for the reference's two solves), for a progress line.

@@ -28,14 +28,16 @@ void prepare_output_dir(const std::string& dir) {
 void write_run_files(const std::string& dir, const RunOutcome& outcome) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  if (ec) throw Error("--out " + dir + ": cannot create the output directory: " + ec.message());
+  if (ec) throw IoError("cannot create the output directory " + dir + ": " + ec.message());
   if (outcome.csv_file.empty()) {
     write_file_atomically(dir + "/invariants.csv", outcome.csv);
   } else {  // streamed while the run went: complete now
     std::filesystem::rename(outcome.csv_file, dir + "/invariants.csv", ec);
-    if (ec) throw Error("cannot rename " + outcome.csv_file + " to " + dir + "/invariants.csv: " + ec.message());
   }
+  // result.json even when the rows are gone (the directory was removed mid-run): what the
+  // run computed is in it.
   write_file_atomically(dir + "/result.json", outcome.result.dump(2) + "\n");
+  if (ec) throw IoError("cannot rename " + outcome.csv_file + " to " + dir + "/invariants.csv: " + ec.message());
 }
 
 }  // namespace tsi::app

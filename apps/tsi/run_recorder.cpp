@@ -8,6 +8,12 @@
 #include <limits>
 #include <set>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include "config.hpp"
 #include "tsi/error.hpp"
 
@@ -64,26 +70,68 @@ RunRecorder::RunRecorder(const Model& model, Reformulation& reformulation, const
   csv_ += "\n";
   drift_from_ = 0.1 * static_cast<double>(config["time"]["t_end"]);  // as the study reports have it
   if (!csv_path.empty()) {
-    csv_file_.open(csv_path, std::ios::out | std::ios::trunc);
-    if (!csv_file_) throw Error("cannot write " + csv_path);
-    const std::string header = csv_;
-    csv_.clear();
-    write_row(header);
+    csv_path_ = csv_path;
+    csv_fd_ = ::open(csv_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (csv_fd_ < 0) throw IoError("cannot write " + csv_path + ": " + std::strerror(errno));
+    pending_.swap(csv_);
+    flush_rows();  // the header, at once
   }
 }
 
-void RunRecorder::write_row(const std::string& row) {
-  if (!csv_file_.is_open()) {
+RunRecorder::~RunRecorder() {
+  if (csv_fd_ < 0) return;
+  try {
+    flush_rows();
+  } catch (const std::exception&) {  // already cut back to its last whole row
+  }
+  ::close(csv_fd_);
+}
+
+void RunRecorder::finish_csv() {
+  if (csv_fd_ < 0) return;
+  flush_rows();
+  const int fd = csv_fd_;
+  csv_fd_ = -1;
+  if (::close(fd) != 0) throw IoError("cannot write " + csv_path_ + ": " + std::strerror(errno));
+}
+
+void RunRecorder::flush_rows() {
+  last_flush_ = std::chrono::steady_clock::now();
+  if (pending_.empty() || csv_fd_ < 0) return;
+  size_t done = 0;
+  while (done < pending_.size()) {
+    const ssize_t n = ::write(csv_fd_, pending_.data() + done, pending_.size() - done);
+    if (n >= 0) {
+      done += static_cast<size_t>(n);
+      continue;
+    }
+    if (errno == EINTR) continue;
+    // A full disk or a file size limit: keep the whole rows written before, drop the rest,
+    // and stop writing (the run stops on this error).
+    const int err = errno;
+    const bool cut = ::ftruncate(csv_fd_, static_cast<off_t>(written_)) == 0;
+    ::close(csv_fd_);
+    csv_fd_ = -1;
+    pending_.clear();
+    throw IoError(fmt::format("cannot write {}: {}{}", csv_path_, std::strerror(err),
+                              cut ? "" : " (and it could not be cut back to its last whole row)"));
+  }
+  written_ += static_cast<long long>(pending_.size());
+  t_written_ = t_pending_;
+  pending_.clear();
+}
+
+void RunRecorder::write_row(const std::string& row, double t) {
+  if (csv_path_.empty()) {
     csv_ += row;
     return;
   }
-  csv_file_ << row;
-  const auto now = std::chrono::steady_clock::now();
-  if (now - last_flush_ > std::chrono::seconds(1)) {  // on disk within a second of being computed
-    csv_file_.flush();
-    last_flush_ = now;
-  }
-  if (!csv_file_) throw Error("writing invariants.csv failed (disk full?)");
+  if (csv_fd_ < 0) return;  // a write failed: the run is being stopped
+  pending_ += row;
+  t_pending_ = t;
+  // On disk within a second of being computed, and never more than 64 KiB in memory.
+  if (pending_.size() >= 65536 || std::chrono::steady_clock::now() - last_flush_ > std::chrono::seconds(1))
+    flush_rows();
 }
 
 double RunRecorder::drift(int k) const {
@@ -148,7 +196,7 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
     std::string row = fmt::format("{:.17g},{:.17g},{:.17g},{:.17g},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}", t, values[0],
                                   values[1], values[2], errors[0], errors[1], errors[2], roughness, spread);
     for (const auto& d : declared_) row += fmt::format(",{:.17g},{:.6e}", d.final, d.change);
-    write_row(row + "\n");
+    write_row(row + "\n", t);
     if (t >= drift_from_)
       for (int k = 0; k < 3; ++k) {
         // The printed value, as a drift fitted to the file would see it.

@@ -1,6 +1,6 @@
 #pragma once
 #include <chrono>
-#include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -22,10 +22,21 @@ class RunRecorder {
   /// data: its rounding would make a relative change meaningless).
   static constexpr double relative_change_threshold = 1e-12;
 
-  /// With a `csv_path`, the rows of invariants.csv go to that file as they are made (flushed
-  /// at least every second), not into memory: a run killed part-way leaves them on disk.
+  /// With a `csv_path`, the rows of invariants.csv go to that file as they are made (written
+  /// at least every second and every 64 KiB), not into memory: a run killed part-way leaves
+  /// them on disk, and memory stays constant however long the run.
+  /// A failed write (a full disk) throws IoError naming the file, after cutting the file back
+  /// to its last whole row: the file is always a valid CSV.
   RunRecorder(const Model& model, Reformulation& reformulation, const Vector& u0, const Json& config,
               const std::string& csv_path = "");
+  ~RunRecorder();
+  RunRecorder(const RunRecorder&) = delete;
+  RunRecorder& operator=(const RunRecorder&) = delete;
+
+  /// Writes the rows not yet on disk and closes the file (IoError when that fails).
+  void finish_csv();
+  /// The time of the last row on disk (NaN before any).
+  double csv_written_to() const { return t_written_; }
 
   /// The step observer: false stops the integration.
   bool observe(long n, double t, const Vector& y);
@@ -71,11 +82,17 @@ class RunRecorder {
   double t_ = 0.0, roughness_max_ = 0.0, spread_max_ = 0.0, spread_baseline_ = 0.0;
   bool roughness_warned_ = false, spread_warned_ = false;
   std::string status_ = "running", message_, csv_;
-  std::ofstream csv_file_;  // open when streaming
+  // Streaming: whole rows wait in pending_ and go to the file descriptor together; written_
+  // bytes of whole rows are on disk (the file is cut back to them when a write fails).
+  int csv_fd_ = -1;
+  std::string csv_path_, pending_;
+  long long written_ = 0;
+  double t_pending_ = std::numeric_limits<double>::quiet_NaN(), t_written_ = t_pending_;
   std::chrono::steady_clock::time_point last_flush_ = std::chrono::steady_clock::now();
+  void flush_rows();
   double drift_from_ = 0.0;
   double drift_sums_[3][5] = {};  // per invariant: n, sum t, sum y, sum t^2, sum t y
-  void write_row(const std::string& row);
+  void write_row(const std::string& row, double t);
   Json warnings_ = Json::array();
 };
 

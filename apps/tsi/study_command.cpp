@@ -1,6 +1,7 @@
 #include "study_command.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -79,7 +80,11 @@ int study_command(PluginLoader& loader, Registry& registry, const std::string& s
   if (tty) fmt::print(stderr, "\r{:70}\r", "");
 
   const Json rows = study_rows(study, outcomes);
-  write_study_files(out_dir, study, outcomes, rows, wall, jobs);
+  // Every run's files, then the table; an output that could not be written is exit code 3.
+  std::vector<std::string> io_errors;
+  for (size_t i = 0; i < outcomes.size(); ++i)
+    if (!outcomes[i].io_error.empty()) io_errors.push_back(study.runs[i].id + ": " + outcomes[i].message);
+  for (auto& e : write_study_files(out_dir, study, outcomes, rows, wall, jobs)) io_errors.push_back(std::move(e));
   fmt::print("{}", study_text(study, rows));
   fmt::print("  wall time {:.2f} s on {} threads\n", wall, jobs);
   fmt::print("  written: {0}/table.csv, {0}/study.json, {0}/runs/\n", out_dir);
@@ -94,6 +99,11 @@ int study_command(PluginLoader& loader, Registry& registry, const std::string& s
     } else {
       fmt::print("  no plots: install python3-matplotlib, then run: python3 {} {}\n", script, out_dir);
     }
+  }
+  if (!io_errors.empty()) {
+    for (size_t k = 0; k < io_errors.size() && k < 8; ++k) spdlog::error("{}", io_errors[k]);
+    if (io_errors.size() > 8) spdlog::error("... and {} more outputs that could not be written", io_errors.size() - 8);
+    return 3;
   }
   // A blow-up is a measured outcome (FD and ME blow up on long runs); an error is not.
   for (const auto& row : rows)

@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "run_files.hpp"
+#include "tsi/error.hpp"
 #include "tsi/convergence.hpp"
 #include "tsi/output.hpp"
 #include "tsi/version.hpp"
@@ -282,10 +283,19 @@ Json work_at_error(const Json& rows, const std::vector<double>& targets) {
   return out;
 }
 
-void write_study_files(const std::string& dir, const Study& study, const std::vector<RunOutcome>& outcomes,
-                       const Json& rows, double wall_seconds, int jobs) {
-  for (size_t i = 0; i < study.runs.size(); ++i) write_run_files(dir + "/runs/" + study.runs[i].id, outcomes[i]);
+std::vector<std::string> write_study_files(const std::string& dir, const Study& study,
+                                           const std::vector<RunOutcome>& outcomes, const Json& rows,
+                                           double wall_seconds, int jobs) {
+  std::vector<std::string> failed;
+  for (size_t i = 0; i < study.runs.size(); ++i) {
+    try {
+      write_run_files(dir + "/runs/" + study.runs[i].id, outcomes[i]);
+    } catch (const IoError& e) {
+      failed.emplace_back(e.what());
+    }
+  }
   write_study_table(dir, study, rows, wall_seconds, jobs);
+  return failed;
 }
 
 void write_study_table(const std::string& dir, const Study& study, const Json& rows, double wall_seconds, int jobs,

@@ -26,7 +26,9 @@ Json work_at_error(const Json& rows, const std::vector<double>& targets);
 double drift_slope(const std::string& csv, const std::string& column, double t_from);
 
 /// Writes DIR/table.csv, DIR/study.json and DIR/runs/<id>/{result.json, invariants.csv}.
-void write_study_files(const std::string& dir, const Study& study, const std::vector<RunOutcome>& outcomes,
+/// A run whose files cannot be written (a full disk) does not stop the others nor the table:
+/// the messages of those that failed (IoError) are returned; the table's own failure throws.
+std::vector<std::string> write_study_files(const std::string& dir, const Study& study, const std::vector<RunOutcome>& outcomes,
                        const Json& rows, double wall_seconds, int jobs);
 
 /// Writes DIR/table.csv and DIR/study.json only (the run files are already in place: a merge

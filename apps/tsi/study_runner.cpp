@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "interrupt.hpp"
+#include "tsi/error.hpp"
 #include "tsi/fft.hpp"
 #include "tsi/version.hpp"
 
@@ -95,9 +96,16 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
     const size_t i = task - n_references;
     const StudyRun& run = study.runs[i];
     const ReferenceSolution* reference = nullptr;
+    const auto not_run = [&] {  // not started (its reference may have been cut short too)
+      outcomes[i] = failed_outcome(run, fmt::format("not run: the study was interrupted by signal {}", interrupt_signal()));
+      outcomes[i].result["status"] = "interrupted";
+      tick();
+    };
+    if (interrupted()) return not_run();
     if (run.config.contains("reference")) {
       const size_t r = reference_index.at(reference_key(run.config));
       ready[r].wait();  // taken by a worker before any run was: never a deadlock
+      if (interrupted()) return not_run();
       if (!reference_errors[r].empty()) {
         outcomes[i] = failed_outcome(run, "the reference solution failed: " + reference_errors[r]);
         tick();
@@ -105,15 +113,12 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
       }
       reference = &references[r];
     }
-    if (interrupted()) {  // not started: the study was interrupted
-      outcomes[i] = failed_outcome(run, fmt::format("not run: the study was interrupted by signal {}", interrupt_signal()));
-      outcomes[i].result["status"] = "interrupted";
-      tick();
-      return;
-    }
     try {
       outcomes[i] = execute_run(run.config, registry, {}, reference,
                                 out_dir.empty() ? std::string() : out_dir + "/runs/" + run.id);
+    } catch (const IoError& e) {  // its output directory could not be made or written
+      outcomes[i] = failed_outcome(run, e.what());
+      outcomes[i].io_error = e.what();
     } catch (const std::exception& e) {
       outcomes[i] = failed_outcome(run, e.what());
     }

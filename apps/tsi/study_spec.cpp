@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "config.hpp"
+#include "run.hpp"
 #include "tsi/error.hpp"
 
 namespace tsi::app {
@@ -199,6 +201,19 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
   for (const auto& [path, ids] : study.not_used.items())
     if (ids.size() == study.runs.size())
       throw ConfigError(path, dropped_message[path] + " (set in the base, and no run of the study takes it)");
+  // The work estimate of every run and of each distinct reference, before any runs.
+  std::set<std::string> references;
+  for (const auto& run : study.runs) {
+    try {
+      check_run_steps(run.config);
+      if (run.config.contains("reference") && references.insert(reference_key(run.config)).second)
+        check_reference_cost(run.config, registry);
+    } catch (const ConfigError& e) {
+      const std::string what = e.what();
+      const std::string message = e.field().empty() ? what : what.substr(e.field().size() + 2);
+      throw ConfigError(e.field(), fmt::format("{} (run {}: {})", message, run.id, describe_assignments(run.assignments)));
+    }
+  }
   return study;
 }
 

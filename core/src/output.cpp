@@ -14,10 +14,10 @@ void write_file_atomically(const std::string& path, const std::string& contents)
   const std::string tmp = path + ".tmp." + std::to_string(getpid());
   const auto fail = [&](int err) {
     std::remove(tmp.c_str());
-    return Error("cannot write " + path + ": " + std::strerror(err));
+    return IoError("cannot write " + path + ": " + std::strerror(err));
   };
   std::FILE* file = std::fopen(tmp.c_str(), "wb");
-  if (!file) throw Error("cannot write " + path + ": " + std::strerror(errno));
+  if (!file) throw IoError("cannot write " + path + ": " + std::strerror(errno));
   const bool written = std::fwrite(contents.data(), 1, contents.size(), file) == contents.size() &&
                        std::fflush(file) == 0 && fsync(fileno(file)) == 0;
   const int err = errno;

@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -36,6 +37,7 @@ struct CommandResult {
   int exit_code = -1;  ///< the exit status, or -1 when the process died of a signal
   int signal = 0;      ///< the signal that ended it, 0 when it exited normally
   bool timed_out = false;  ///< killed (SIGKILL) after CommandEnv::timeout_seconds
+  long max_rss_kb = 0;  ///< its peak resident memory (getrusage's ru_maxrss), in KiB
   std::string out;     ///< everything written to stdout
   std::string err;     ///< everything written to stderr
 
@@ -57,6 +59,9 @@ struct CommandEnv {
   int send_signal = 0;                     ///< a signal to send the child (0: none) ...
   double signal_after_seconds = 0.0;       ///< ... this long after it started
   double timeout_seconds = 0.0;            ///< kill the child (SIGKILL) after this long (0: never)
+  /// The child's RLIMIT_FSIZE in bytes (-1: unchanged), with SIGXFSZ ignored: a write past
+  /// it fails with EFBIG, as on a full disk.
+  long long file_size_limit = -1;
 };
 
 namespace detail {
@@ -115,7 +120,25 @@ inline CommandResult run_command(const std::string& program, const std::vector<s
   envp.push_back(nullptr);
 
   pid_t pid = 0;
-  const int spawn_error = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), envp.data());
+  int spawn_error = 0;
+  if (env.file_size_limit < 0) {
+    spawn_error = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), envp.data());
+  } else {  // posix_spawn cannot set a resource limit: fork, set it in the child, exec
+    pid = ::fork();
+    if (pid < 0) spawn_error = errno;
+    if (pid == 0) {  // async-signal-safe calls only
+      const int in = ::open("/dev/null", O_RDONLY);
+      if (in < 0 || ::dup2(in, STDIN_FILENO) < 0 || ::dup2(out_pipe[1], STDOUT_FILENO) < 0 ||
+          ::dup2(err_pipe[1], STDERR_FILENO) < 0 || (!cwd.empty() && ::chdir(cwd.c_str()) != 0))
+        ::_exit(127);
+      const rlimit limit{static_cast<rlim_t>(env.file_size_limit), static_cast<rlim_t>(env.file_size_limit)};
+      struct sigaction ignore {};
+      ignore.sa_handler = SIG_IGN;
+      if (::setrlimit(RLIMIT_FSIZE, &limit) != 0 || ::sigaction(SIGXFSZ, &ignore, nullptr) != 0) ::_exit(127);
+      ::execve(program.c_str(), argv.data(), envp.data());
+      ::_exit(127);
+    }
+  }
   posix_spawn_file_actions_destroy(&actions);
   detail::close_fd(out_pipe[1]);
   detail::close_fd(err_pipe[1]);
@@ -162,8 +185,10 @@ inline CommandResult run_command(const std::string& program, const std::vector<s
   detail::close_fd(fds[1]);
 
   int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  struct rusage usage {};
+  while (::wait4(pid, &status, 0, &usage) < 0 && errno == EINTR) {
   }
+  result.max_rss_kb = usage.ru_maxrss;
   if (WIFEXITED(status)) {
     result.exit_code = WEXITSTATUS(status);
   } else if (WIFSIGNALED(status)) {

@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <csignal>
+#include <cstdlib>
+#include <random>
 #include <string>
+#include <vector>
 
 #include "run_command.hpp"
 
@@ -72,4 +75,128 @@ TEST_CASE("interrupt: even SIGKILL leaves the rows computed more than a second b
   const std::string csv = t::read_text(dir.path() / "out" / "invariants.csv.partial");
   CHECK(std::count(csv.begin(), csv.end(), '\n') > 10);  // streamed, flushed at least once a second
   CHECK(t::contains(csv, "t,H,I,m,err_H"));
+}
+
+namespace {
+
+// Interrupt trials at random moments: TSI_INTERRUPT_TRIALS of them (default `fallback`; the
+// README's numbers are from 20), each moment uniform in [0.05 s, `longest` s].
+std::vector<double> random_moments(int fallback, double longest, unsigned& seed) {
+  int trials = fallback;
+  if (const char* n = std::getenv("TSI_INTERRUPT_TRIALS")) trials = std::max(1, std::atoi(n));
+  seed = std::random_device{}();
+  if (const char* s = std::getenv("TSI_INTERRUPT_SEED")) seed = static_cast<unsigned>(std::strtoul(s, nullptr, 10));
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> moment(0.05, longest);
+  std::vector<double> out;
+  for (int k = 0; k < trials; ++k) out.push_back(moment(random));
+  return out;
+}
+
+// The rows of a streamed invariants.csv: whole lines, as many fields as the header.
+long csv_rows(const t::fs::path& file) {
+  const std::vector<std::string> lines = t::lines_of(t::read_text(file));
+  REQUIRE(!lines.empty());
+  const size_t fields = t::csv_fields(lines[0]).size();
+  const long whole = std::count_if(lines.begin(), lines.end(),
+                                   [&](const std::string& line) { return t::csv_fields(line).size() == fields; });
+  CHECK(whole == static_cast<long>(lines.size()));
+  return static_cast<long>(lines.size()) - 1;
+}
+
+// A run of about 3 s: Henon-Heiles, SE1, 120000 steps (1.6 s), then its rk78 reference and the
+// reference's check (1.7 s).
+t::Json three_second_run() {
+  return {{"model", {{"name", "henon-heiles"}, {"eps", 0.01}}},
+          {"scheme", {{"name", "se1"}}},
+          {"time", {{"h", 0.025}, {"t_end", 3000.0}}},
+          {"reference", t::Json::object()}};
+}
+
+}  // namespace
+
+TEST_CASE("interrupt: SIGINT at random moments of a run keeps a valid result.json with every step made") {
+  unsigned seed = 0;
+  const std::vector<double> moments = random_moments(3, 3.5, seed);
+  MESSAGE("seed " << seed << " (TSI_INTERRUPT_SEED repeats it)");
+  int interrupted = 0, completed = 0, in_reference = 0;
+  for (const double moment : moments) {
+    t::TempDir dir;
+    t::CommandEnv env;
+    env.send_signal = SIGINT;
+    env.signal_after_seconds = moment;
+    const t::CommandResult r = t::run_tsi({"run", t::write_config(dir, three_second_run()), "--out", dir / "out"}, env);
+    INFO("SIGINT after " << moment << " s; " << r.describe());
+    REQUIRE(r.signal == 0);
+    const t::Json result = t::read_json(dir.path() / "out" / "result.json");
+    const std::string status = result.at("status");
+    REQUIRE((status == "interrupted" || status == "completed"));
+    // 130 once the signal is sent; 0 only when the run ended before its moment came.
+    CHECK((r.exit_code == 128 + SIGINT || (status == "completed" && r.exit_code == 0)));
+    const long steps = result.at("steps").get<long>();
+    CHECK(csv_rows(dir.path() / "out" / "invariants.csv") == steps + 1);  // t = 0 and every step
+    CHECK_FALSE(t::fs::exists(dir.path() / "out" / "invariants.csv.partial"));
+    CHECK(result.at("u_final").size() == 4);
+    if (status == "completed") {
+      ++completed;
+      CHECK(steps == 120000);
+      CHECK(result.at("error").at("relative").is_number());
+    } else {
+      ++interrupted;
+      CHECK(t::contains(result.at("message").get<std::string>(), "interrupted"));
+      if (steps == 120000) {  // the run was done, its reference was not
+        ++in_reference;
+        CHECK(t::contains(result.at("message").get<std::string>(), "while computing the reference"));
+        CHECK_FALSE(result.contains("error"));
+      }
+    }
+  }
+  MESSAGE(moments.size() << " interrupts: " << interrupted << " interrupted (" << in_reference
+                         << " in the reference), " << completed << " completed before the signal");
+}
+
+TEST_CASE("interrupt: SIGINT at random moments of a study keeps study.json and every finished run") {
+  const t::Json spec = {{"kind", "convergence"},
+                        {"base", {{"model", {{"name", "henon-heiles"}, {"eps", 0.01}}},
+                                  {"time", {{"t_end", 800.0}}},
+                                  {"reference", t::Json::object()}}},
+                        {"vary", {{"scheme.name", {"se1", "se2"}}, {"time.h", {0.05, 0.025, 0.0125}}}}};
+  unsigned seed = 0;
+  const std::vector<double> moments = random_moments(3, 3.5, seed);
+  MESSAGE("seed " << seed << " (TSI_INTERRUPT_SEED repeats it)");
+  long finished_runs = 0, stopped_runs = 0;
+  for (const double moment : moments) {
+    t::TempDir dir;
+    t::CommandEnv env;
+    env.send_signal = SIGINT;
+    env.signal_after_seconds = moment;
+    const t::CommandResult r = t::run_tsi(
+        {"study", t::write_config(dir, spec, "study.json"), "--out", dir / "out", "--no-plots", "--jobs", "2"}, env);
+    INFO("SIGINT after " << moment << " s; " << r.describe());
+    REQUIRE(r.signal == 0);
+    CHECK((r.exit_code == 128 + SIGINT || r.exit_code == 0));  // 0: the study ended before its moment
+    const t::Json study = t::read_json(dir.path() / "out" / "study.json");
+    REQUIRE(study.at("table").size() == 6);
+    if (r.exit_code == 0)
+      for (const auto& row : study.at("table")) CHECK(row.at("status") == "completed");
+    CHECK(t::lines_of(t::read_text(dir.path() / "out" / "table.csv")).size() == 7);
+    for (const auto& row : study.at("table")) {
+      const std::string id = row.at("id"), status = row.at("status");
+      INFO(id << ": " << row.dump());
+      REQUIRE((status == "completed" || status == "interrupted"));
+      const t::fs::path run = dir.path() / "out" / "runs" / id;
+      const t::Json result = t::read_json(run / "result.json");
+      CHECK(result.at("status") == status);
+      if (status == "completed") {
+        ++finished_runs;
+        CHECK(result.at("error").at("relative").is_number());
+        CHECK(csv_rows(run / "invariants.csv") == result.at("steps").get<long>() + 1);
+      } else {
+        ++stopped_runs;
+        if (result.value("steps", 0L) > 0) CHECK(csv_rows(run / "invariants.csv") == result.at("steps").get<long>() + 1);
+      }
+    }
+  }
+  MESSAGE(moments.size() << " interrupts: " << finished_runs << " runs completed and kept, " << stopped_runs
+                         << " interrupted or not started");
 }

@@ -405,8 +405,8 @@ TEST_CASE("run errors: a reference that could not finish is refused before the r
   // rk78 on the filtered problem at eps = 1e-300 needs 8 steps per period 2 pi eps: ~1e300.
   check_bad_input(run_example_with({"model.eps=1e-300", "reference={}"}), "reference",
                   {"would take at least", "use a two-scale reference"});
-  check_bad_input(run_example_with({"reference={\"scheme\": \"se1\", \"reformulation\": \"two-scale\", \"h\": 1e-9}"}),
-                  "reference.h", {"got 1e-09", "at most 1e+08"});
+  check_bad_input(run_example_with({"reference={\"scheme\": \"se1\", \"reformulation\": \"two-scale\", \"h\": 1e-10}"}),
+                  "reference.h", {"got 1e-10", "1e+10 steps", "at most 1e+09", "--max-steps N"});
 }
 
 TEST_CASE("run errors: a run that cannot fit in memory is refused before anything is allocated") {

@@ -24,6 +24,13 @@ class TSI_API ConfigError : public Error {
   std::string field_;
 };
 
+/// An output that could not be written (a full disk, a file size limit, a directory that went
+/// away): what() names the file and the system's reason. The runner exits with 3 on it.
+class TSI_API IoError : public Error {
+ public:
+  using Error::Error;
+};
+
 /// A plugin that could not be loaded or registered.
 class TSI_API PluginError : public Error {
  public:
