@@ -1,7 +1,7 @@
 // tsi: the runner. Wires model, reformulation and scheme together from a JSON config.
 //   tsi list [models|reformulations|schemes] [--json]
 //   tsi run CONFIG.json [--out DIR] [--set key.path=value ...] [--max-steps N]
-//   tsi study STUDY.json [--out DIR] [--jobs N] [--shard i/N] [--max-steps N]; tsi study --merge DIR... --out DIR
+//   tsi study STUDY.json [--out DIR] [--jobs N] [--shard i/N] [--max-steps N] [--resume | --force]; tsi study --merge DIR... --out DIR
 // Exit codes: 0 success, 1 a run failed (its files are still written), 2 bad input, 3 an output
 // could not be written (what could be is kept valid), 128 + N interrupted by signal N.
 #include <fmt/format.h>
@@ -130,6 +130,9 @@ int main(int argc, char** argv) {
   study->add_option("--shard", shard, "run only shard i of N (i = 1..N) into --out; see --merge");
   study->add_option("--merge", merge_dirs, "merge the output directories of all shards of a study into --out")
       ->expected(1, -1);
+  bool resume = false, force = false;
+  study->add_flag("--resume", resume, "keep the runs of this study that finished in --out (an interrupted study), run the rest");
+  study->add_flag("--force", force, "replace the results of another study in --out instead of refusing");
 
   // tsi check [MODEL] [--plugin FILE] [--scheme NAME] [--eps EPS] (check_command.hpp)
   auto* check = app.add_subcommand("check", "run the conformance checks on a model or plugin");
@@ -181,7 +184,7 @@ int main(int argc, char** argv) {
     tsi::app::set_max_steps(max_steps);
     const int rc = study->parsed()
                        ? tsi::app::study_entry(loader, registry,
-                                               {study_path, study_out, jobs, study_overrides, !no_plots, shard, merge_dirs})
+                                               {study_path, study_out, jobs, study_overrides, !no_plots, shard, merge_dirs, resume, force})
                        : run_command(loader, registry, config_path, out_dir, overrides);
     if (tsi::app::interrupted() && rc != 3) {  // an output that failed is said first
       spdlog::error("interrupted by signal {}: what was computed is written", tsi::app::interrupt_signal());

@@ -37,7 +37,7 @@ std::string plot_script_path() {
 }
 
 int study_command(PluginLoader& loader, Registry& registry, const std::string& study_path, std::string out_dir,
-                  int jobs, const std::vector<std::string>& overrides, bool plots) {
+                  int jobs, const std::vector<std::string>& overrides, bool plots, bool resume, bool force) {
   Json spec = load_config_file(study_path);
   if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
     load_config_plugins(loader, spec["base"]["plugins"], study_path);
@@ -57,12 +57,43 @@ int study_command(PluginLoader& loader, Registry& registry, const std::string& s
       } catch (const Error&) {
         earlier = Json();
       }
-      if (earlier != study.spec)
-        throw ConfigError("--out", "\"" + out_dir + "\" holds the results of another study (" +
-                                       (earlier.is_object() ? earlier.value("title", std::string("untitled")) : "unreadable") +
-                                       "); choose another --out, or remove that directory");
+      if (earlier != study.spec && !force)
+        throw ConfigError(resume ? "--resume" : "--out",
+                          "\"" + out_dir + "\" holds the results of another study (" +
+                              (earlier.is_object() ? earlier.value("title", std::string("untitled")) : "unreadable") +
+                              "); choose another --out, or replace them with --force");
+      if (earlier != study.spec)  // --force: the other study's files go (only what tsi writes)
+        for (const char* name : {"study.json", "table.csv", "convergence.png", "conservation.png", "work_precision.png"})
+          fs::remove(fs::path(out_dir) / name, ec);
+    } else {
+      resume = false;  // nothing to resume
     }
-    fs::remove_all(fs::path(out_dir) / "runs", ec);
+    if (!resume) fs::remove_all(fs::path(out_dir) / "runs", ec);
+  }
+  // --resume: the runs that finished (completed or blew up) are read back, the others run.
+  std::vector<RunOutcome> finished(study.runs.size());
+  std::vector<bool> skip(study.runs.size(), false);
+  size_t kept = 0;
+  if (resume) {
+    for (size_t i = 0; i < study.runs.size(); ++i) {
+      const std::string dir = out_dir + "/runs/" + study.runs[i].id;
+      std::error_code ec;
+      if (!std::filesystem::exists(dir + "/invariants.csv", ec)) continue;
+      try {
+        Json result = load_config_file(dir + "/result.json");
+        const std::string status = result.value("status", std::string());
+        if ((status != "completed" && status != "blow-up") || result.value("config", Json()) != study.runs[i].config)
+          continue;
+        finished[i].ok = true;
+        finished[i].message = result.value("message", std::string());
+        finished[i].csv_file = dir + "/invariants.csv";  // in place: written again as itself
+        finished[i].result = std::move(result);
+        skip[i] = true;
+        ++kept;
+      } catch (const Error&) {
+        // unreadable: run it again
+      }
+    }
   }
   if (jobs <= 0) jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 
@@ -74,8 +105,12 @@ int study_command(PluginLoader& loader, Registry& registry, const std::string& s
     const double estimate = done ? elapsed * static_cast<double>(total - done) / static_cast<double>(done) : 0.0;
     fmt::print(stderr, "\r  {}/{} done, {:.1f} s elapsed, about {:.0f} s to go   ", done, total, elapsed, estimate);
   };
-  if (tty) fmt::print(stderr, "  {} runs on {} threads\n", study.runs.size(), jobs);
-  const auto outcomes = run_study(study, registry, jobs, progress, out_dir);
+  if (tty) fmt::print(stderr, "  {} runs on {} threads\n", study.runs.size() - kept, jobs);
+  if (resume) fmt::print("  resumed: {} of {} runs finished earlier are kept, {} to run\n", kept, study.runs.size(),
+                         study.runs.size() - kept);
+  auto outcomes = run_study(study, registry, jobs, progress, out_dir, skip);
+  for (size_t i = 0; i < outcomes.size(); ++i)
+    if (skip[i]) outcomes[i] = std::move(finished[i]);
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   if (tty) fmt::print(stderr, "\r{:70}\r", "");
 

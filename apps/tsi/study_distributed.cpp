@@ -359,14 +359,21 @@ int study_entry(PluginLoader& loader, Registry& registry, const StudyCli& cli) {
     throw ConfigError("study", "missing the study file: tsi study STUDY.json [--out DIR] [--shard i/N], "
                                "or tsi study --merge DIR1 DIR2 ... --out DIR");
   const ShardSpec shard = cli.shard.empty() ? ShardSpec{} : parse_shard(cli.shard);
+  if (cli.resume && cli.force) throw ConfigError("--resume", "cannot be combined with --force (which replaces the results)");
+  if ((cli.resume || cli.force) && !cli.shard.empty())
+    throw ConfigError(cli.resume ? "--resume" : "--force", "applies to a whole study, not to a shard");
 #ifdef TSI_WITH_MPI
   if (mpi_launched()) {
     if (!cli.shard.empty()) throw ConfigError("--shard", "cannot be combined with mpirun: use one or the other");
+    if (cli.resume || cli.force)
+      throw ConfigError(cli.resume ? "--resume" : "--force", "is not available under mpirun: run without mpirun, "
+                                                             "or choose another --out");
     return mpi_study_command(loader, registry, cli);
   }
 #endif
   if (!cli.shard.empty()) return shard_command(loader, registry, cli, shard);
-  return study_command(loader, registry, cli.study_path, cli.out_dir, cli.jobs, cli.overrides, cli.plots);
+  return study_command(loader, registry, cli.study_path, cli.out_dir, cli.jobs, cli.overrides, cli.plots, cli.resume,
+                       cli.force);
 }
 
 }  // namespace tsi::app

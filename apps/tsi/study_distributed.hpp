@@ -19,6 +19,8 @@ struct StudyCli {
   bool plots = true;                    ///< not --no-plots
   std::string shard;                    ///< --shard i/N ("" : the whole study)
   std::vector<std::string> merge_dirs;  ///< --merge DIR... (empty: no merge)
+  bool resume = false;                  ///< --resume: keep the finished runs of this study in --out
+  bool force = false;                   ///< --force: replace another study's results in --out
 };
 
 /// Runs `tsi study` as the command line asks: the whole study (study_command), one shard of

@@ -42,12 +42,15 @@ RunOutcome failed_outcome(const StudyRun& run, const std::string& message) {
 }  // namespace
 
 std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, int jobs,
-                                  const StudyProgressFn& progress, const std::string& out_dir) {
-  // Distinct references, each computed once.
+                                  const StudyProgressFn& progress, const std::string& out_dir,
+                                  const std::vector<bool>& skip) {
+  const auto skipped = [&](size_t i) { return i < skip.size() && skip[i]; };
+  // Distinct references, each computed once, for the runs to run.
   std::map<std::string, size_t> reference_index;
   std::vector<const Json*> reference_configs;
-  for (const auto& run : study.runs) {
-    if (!run.config.contains("reference")) continue;
+  for (size_t i = 0; i < study.runs.size(); ++i) {
+    const auto& run = study.runs[i];
+    if (skipped(i) || !run.config.contains("reference")) continue;
     if (reference_index.emplace(reference_key(run.config), reference_configs.size()).second)
       reference_configs.push_back(&run.config);
   }
@@ -94,6 +97,10 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
       return;
     }
     const size_t i = task - n_references;
+    if (skipped(i)) {  // its outcome is the caller's (resumed from its files)
+      tick();
+      return;
+    }
     const StudyRun& run = study.runs[i];
     const ReferenceSolution* reference = nullptr;
     const auto not_run = [&] {  // not started (its reference may have been cut short too)

@@ -16,6 +16,7 @@ using StudyProgressFn = std::function<void(size_t done, size_t total)>;
 /// order of study.runs.
 /// With `out_dir`, each run streams its invariants.csv rows into out_dir/runs/<id>/ as it goes.
 std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, int jobs,
-                                  const StudyProgressFn& progress = {}, const std::string& out_dir = "");
+                                  const StudyProgressFn& progress = {}, const std::string& out_dir = "",
+                                  const std::vector<bool>& skip = {});
 
 }  // namespace tsi::app

@@ -181,3 +181,44 @@ TEST_CASE("study: one --out holds one study: another is refused, the same one re
   CHECK(contains(other.err, "holds the results of another study"));
   CHECK(fs::exists(fs::path(out) / "runs" / "r0002" / "result.json"));  // untouched
 }
+
+TEST_CASE("study: --force replaces another study's results; --resume keeps the finished runs of the same one") {
+  TempDir dir;
+  const Json first = {{"kind", "convergence"},
+                      {"base", {{"model", {{"name", "hh"}}}, {"time", {{"t_end", 0.5}}}}},
+                      {"vary", {{"time.h", {0.25, 0.125}}}}};
+  Json second = first;
+  second["vary"]["time.h"] = {0.5};
+  const std::string out = dir / "out";
+  const std::string first_path = write_config(dir, first, "first.json");
+  REQUIRE(run_tsi({"study", first_path, "--out", out, "--no-plots"}).exit_code == 0);
+
+  // --resume: r0001 is kept as it is on disk (a marker in its result.json survives, and reaches
+  // the table), r0002, whose files are gone, runs again.
+  const fs::path kept = fs::path(out) / "runs" / "r0001" / "result.json";
+  Json marked = Json::parse(read_text(kept.string()));
+  marked["wall_seconds"] = 12345.0;
+  std::ofstream(kept) << marked.dump(2) << "\n";
+  fs::remove_all(fs::path(out) / "runs" / "r0002");
+  const auto resumed = run_tsi({"study", first_path, "--out", out, "--no-plots", "--resume"});
+  INFO(resumed.describe());
+  REQUIRE(resumed.exit_code == 0);
+  CHECK(contains(resumed.out, "resumed: 1 of 2 runs finished earlier are kept, 1 to run"));
+  CHECK(Json::parse(read_text(kept.string()))["wall_seconds"] == 12345.0);
+  CHECK(fs::exists(fs::path(out) / "runs" / "r0002" / "invariants.csv"));
+  CHECK(contains(read_text(out + "/table.csv"), "12345"));
+
+  // Another study: refused with --resume, replaced with --force.
+  const std::string second_path = write_config(dir, second, "second.json");
+  const auto refused = run_tsi({"study", second_path, "--out", out, "--no-plots", "--resume"});
+  CHECK(refused.exit_code == 2);
+  CHECK(contains(refused.err, "--resume: "));
+  const auto forced = run_tsi({"study", second_path, "--out", out, "--no-plots", "--force"});
+  INFO(forced.describe());
+  REQUIRE(forced.exit_code == 0);
+  CHECK_FALSE(fs::exists(fs::path(out) / "runs" / "r0002"));
+  CHECK(Json::parse(read_text(out + "/study.json"))["study"] == second);
+  const auto both = run_tsi({"study", second_path, "--out", out, "--resume", "--force"});
+  CHECK(both.exit_code == 2);
+  CHECK(contains(both.err, "--resume: cannot be combined with --force"));
+}
