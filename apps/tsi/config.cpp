@@ -58,7 +58,10 @@ const ParamSchema& reference_schema() {
 const ParamSchema& output_schema() {
   static const ParamSchema schema = {
       integer_param("every", 1, "write a row of invariants.csv every this many steps")
-          .check([](const Json& v) { return v.get<long>() >= 1; }, "a positive integer")};
+          .check([](const Json& v) { return v.get<long>() >= 1; }, "a positive integer"),
+      number_param("checkpoint_seconds", 30.0,
+                   "rewrite result.json (status running, the time reached) at most this often while a run goes")
+          .range(0.0, 1e9, true, false)};
   return schema;
 }
 

@@ -15,6 +15,7 @@
 #include "tsi/phase.hpp"
 #include "tsi/driver.hpp"
 #include "tsi/error.hpp"
+#include "tsi/output.hpp"
 #include "tsi/version.hpp"
 
 namespace tsi::app {
@@ -256,7 +257,22 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   }
   RunRecorder recorder(*model, *reformulation, u0, config, outcome.csv_file);
   std::string status = "completed";
-  auto last_progress = Clock::now();
+  auto last_progress = Clock::now(), last_checkpoint = Clock::now();
+  const double checkpoint_seconds = config.contains("output") ? config["output"].value("checkpoint_seconds", 30.0) : 30.0;
+  // A checkpoint: result.json says how far the run got, so that a kill -9 or a power cut
+  // leaves, besides the streamed rows, a record of the run (replaced by the full one at the end).
+  const auto checkpoint = [&](long n, double t) {
+    recorder.flush_csv();  // the rows first: a checkpoint never claims more than the file holds
+    Json partial = result;
+    partial["status"] = "running";
+    partial["message"] = fmt::format("a checkpoint at t = {:.6g} (step {} of {}); invariants.csv.partial holds the "
+                                     "rows up to here", t, n, n_steps);
+    partial["t_reached"] = t;
+    partial["steps_done"] = n;
+    partial["wall_seconds"] = seconds_since(start);
+    write_file_atomically(stream_dir + "/result.json", partial.dump(2) + "\n");  // IoError: an I/O failure
+    last_checkpoint = Clock::now();
+  };
   try {
     Vector y = reformulation->prepare(u0);
     const int data_order = reformulation->data_order_reached();
@@ -280,6 +296,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
         progress(static_cast<double>(n) / static_cast<double>(std::max(1L, n_steps)), "run");
         last_progress = Clock::now();
       }
+      if (go_on && !stream_dir.empty() && seconds_since(last_checkpoint) > checkpoint_seconds) checkpoint(n, t);
       return go_on;
     });
     if (status == "completed" && recorder.status() != "running") {

@@ -35,6 +35,8 @@ class RunRecorder {
 
   /// Writes the rows not yet on disk and closes the file (IoError when that fails).
   void finish_csv();
+  /// Writes the rows not yet on disk, keeping the file open (before a checkpoint).
+  void flush_csv() { flush_rows(); }
   /// The time of the last row on disk (NaN before any).
   double csv_written_to() const { return t_written_; }
 

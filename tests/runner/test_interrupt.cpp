@@ -61,11 +61,12 @@ TEST_CASE("interrupt: a study stopped by SIGINT writes its table with every run'
   CHECK(first.at("steps").get<long>() > 0);
 }
 
-TEST_CASE("interrupt: even SIGKILL leaves the rows computed more than a second before on disk") {
+TEST_CASE("interrupt: even SIGKILL leaves the rows computed more than a second before on disk, and a checkpoint") {
   t::TempDir dir;
   const t::Json config = {{"model", {{"name", "nls"}, {"eps", 0.1}, {"n_x", 64}}},
                           {"scheme", {{"name", "se1"}}},
-                          {"time", {{"h", 0.01}, {"t_end", 1000.0}}}};
+                          {"time", {{"h", 0.01}, {"t_end", 1000.0}}},
+                          {"output", {{"checkpoint_seconds", 0.5}}}};
   t::CommandEnv env;
   env.send_signal = SIGKILL;
   env.signal_after_seconds = 2.5;
@@ -75,6 +76,14 @@ TEST_CASE("interrupt: even SIGKILL leaves the rows computed more than a second b
   const std::string csv = t::read_text(dir.path() / "out" / "invariants.csv.partial");
   CHECK(std::count(csv.begin(), csv.end(), '\n') > 10);  // streamed, flushed at least once a second
   CHECK(t::contains(csv, "t,H,I,m,err_H"));
+  // result.json from the last checkpoint (every 0.5 s): how far the run got, within the rows.
+  const t::Json checkpoint = t::read_json(dir.path() / "out" / "result.json");
+  CHECK(checkpoint.at("status") == "running");
+  CHECK(checkpoint.at("config").at("model").at("name") == "nls");
+  const long done = checkpoint.at("steps_done").get<long>();
+  CHECK(done > 0);
+  CHECK(checkpoint.at("t_reached").get<double>() > 0.0);
+  CHECK(std::count(csv.begin(), csv.end(), '\n') >= done + 2);  // header and t = 0, then the rows reach the checkpoint (flushed before it)
 }
 
 namespace {
