@@ -223,7 +223,7 @@ Json resolve_run_config(const Json& raw, const Registry& registry) {
         throw ConfigError("reference.h", fmt::format("got {}, expected t_end / n for a whole number n of steps "
                                                      "(t_end = {}: {:.6g} steps)",
                                                      h, t_end, steps));
-      if (steps > 1e12) throw ConfigError("reference.h", fmt::format("t_end / h = {:.3g} steps is too many", steps));
+      if (steps > 1e12) throw ConfigError("reference.h", fmt::format("t_end / h = {:.3g} steps is too many: at most 1e12, the largest --max-steps", steps));
     }
     out["reference"] = ref;
   }
@@ -255,7 +255,7 @@ long step_count(const Json& resolved) {
     throw ConfigError("time.h", fmt::format("t_end = {} is not a whole number of steps of h = {} "
                                             "({:.6g} steps); choose h = t_end / n",
                                             t_end, h, steps));
-  if (whole > 1e12) throw ConfigError("time.h", fmt::format("t_end / h = {:.3g} steps is too many", steps));
+  if (whole > 1e12) throw ConfigError("time.h", fmt::format("t_end / h = {:.3g} steps is too many: at most 1e12, the largest --max-steps", steps));
   return static_cast<long>(whole);
 }
 
