@@ -26,6 +26,15 @@ std::string shell_quoted(const std::string& s) { return "'" + s + "'"; }
 
 }  // namespace
 
+StudyProgressFn terminal_progress(bool tty, std::chrono::steady_clock::time_point start) {
+  return [tty, start](size_t done, size_t total) {
+    if (!tty) return;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double estimate = done ? elapsed * static_cast<double>(total - done) / static_cast<double>(done) : 0.0;
+    fmt::print(stderr, "\r  {}/{} done, {:.1f} s elapsed, about {:.0f} s to go   ", done, total, elapsed, estimate);
+  };
+}
+
 std::string plot_script_path() {
   std::error_code ec;
   const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
@@ -44,32 +53,7 @@ int study_command(PluginLoader& loader, Registry& registry, const std::string& s
   const Study study = expand_study(spec, registry, overrides);
   if (out_dir.empty()) out_dir = "out/" + std::filesystem::path(study_path).stem().string();
   prepare_output_dir(out_dir);
-  {
-    // One --out, one study: another study's results are never mixed with these; the same
-    // study again replaces its earlier runs (a smaller expansion would leave stale ones).
-    namespace fs = std::filesystem;
-    const fs::path previous = fs::path(out_dir) / "study.json";
-    std::error_code ec;
-    if (fs::exists(previous, ec)) {
-      Json earlier;
-      try {
-        earlier = load_config_file(previous.string()).value("study", Json());
-      } catch (const Error&) {
-        earlier = Json();
-      }
-      if (earlier != study.spec && !force)
-        throw ConfigError(resume ? "--resume" : "--out",
-                          "\"" + out_dir + "\" holds the results of another study (" +
-                              (earlier.is_object() ? earlier.value("title", std::string("untitled")) : "unreadable") +
-                              "); choose another --out, or replace them with --force");
-      if (earlier != study.spec)  // --force: the other study's files go (only what tsi writes)
-        for (const char* name : {"study.json", "table.csv", "convergence.png", "conservation.png", "work_precision.png"})
-          fs::remove(fs::path(out_dir) / name, ec);
-    } else {
-      resume = false;  // nothing to resume
-    }
-    if (!resume) fs::remove_all(fs::path(out_dir) / "runs", ec);
-  }
+  resume = claim_study_dir(out_dir, study, resume, force);
   // --resume: the runs that finished (completed or blew up) are read back, the others run.
   std::vector<RunOutcome> finished(study.runs.size());
   std::vector<bool> skip(study.runs.size(), false);
@@ -99,12 +83,7 @@ int study_command(PluginLoader& loader, Registry& registry, const std::string& s
 
   const bool tty = isatty(fileno(stderr));
   const auto start = Clock::now();
-  auto progress = [&](size_t done, size_t total) {
-    if (!tty) return;
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    const double estimate = done ? elapsed * static_cast<double>(total - done) / static_cast<double>(done) : 0.0;
-    fmt::print(stderr, "\r  {}/{} done, {:.1f} s elapsed, about {:.0f} s to go   ", done, total, elapsed, estimate);
-  };
+  const StudyProgressFn progress = terminal_progress(tty, start);
   if (tty) fmt::print(stderr, "  {} runs on {} threads\n", study.runs.size() - kept, jobs);
   if (resume) fmt::print("  resumed: {} of {} runs finished earlier are kept, {} to run\n", kept, study.runs.size(),
                          study.runs.size() - kept);

@@ -1,7 +1,9 @@
 #pragma once
+#include <chrono>
 #include <string>
 #include <vector>
 
+#include "study_runner.hpp"
 #include "tsi/plugin_loader.hpp"
 
 namespace tsi::app {
@@ -15,6 +17,9 @@ namespace tsi::app {
 int study_command(PluginLoader& loader, Registry& registry, const std::string& study_path,
                   std::string out_dir, int jobs, const std::vector<std::string>& overrides, bool plots,
                   bool resume = false, bool force = false);
+
+/// A study's progress line on stderr (done/total, elapsed, time to go), silent when not `tty`.
+StudyProgressFn terminal_progress(bool tty, std::chrono::steady_clock::time_point start);
 
 /// The plotting script (python3 + matplotlib) next to the sources or the installed runner.
 std::string plot_script_path();

@@ -316,35 +316,6 @@ std::vector<size_t> shard_runs(const Study& study, long index, long count) {
   return mine;
 }
 
-void claim_study_dir(const std::string& out_dir, const Study& study) {
-  // One --out, one study: another study's results are never mixed with these; the same
-  // study again replaces its earlier runs.
-  const fs::path previous = fs::path(out_dir) / "study.json";
-  std::error_code ec;
-  if (fs::exists(previous, ec)) {
-    Json earlier;
-    try {
-      earlier = load_config_file(previous.string()).value("study", Json());
-    } catch (const Error&) {
-      earlier = Json();
-    }
-    if (earlier != study.spec)
-      throw ConfigError("--out", "\"" + out_dir + "\" holds the results of another study (" +
-                                     (earlier.is_object() ? earlier.value("title", std::string("untitled")) : "unreadable") +
-                                     "); choose another --out, or remove that directory");
-  }
-  fs::remove_all(fs::path(out_dir) / "runs", ec);
-}
-
-RunOutcome failed_run_outcome(const StudyRun& run, const std::string& message) {
-  RunOutcome o;
-  o.ok = false;
-  o.message = message;
-  o.result = {{"tsi_version", version_string}, {"config", run.config}, {"status", "failed"},
-              {"message", message}, {"warnings", Json::array()}};
-  return o;
-}
-
 int study_entry(PluginLoader& loader, Registry& registry, const StudyCli& cli) {
   if (!cli.merge_dirs.empty()) {
     if (!cli.study_path.empty())

@@ -44,13 +44,6 @@ double expected_run_cost(const Json& config);
 /// (ties to the lowest index). Deterministic: depends on the study only.
 std::vector<size_t> shard_runs(const Study& study, long index, long count);
 
-/// Refuses (ConfigError naming --out) an output directory that holds another study's results,
-/// and removes its runs/ otherwise (a smaller expansion would leave stale ones).
-void claim_study_dir(const std::string& out_dir, const Study& study);
-
-/// A run that did not run (or threw): status failed, with the message.
-RunOutcome failed_run_outcome(const StudyRun& run, const std::string& message);
-
 #ifdef TSI_WITH_MPI
 /// Whether this process was started by mpirun (or another launcher), with any number of ranks.
 bool mpi_launched();

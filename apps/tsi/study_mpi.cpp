@@ -36,6 +36,7 @@
 #include "run_files.hpp"
 #include "study_command.hpp"
 #include "study_distributed.hpp"
+#include "study_runner.hpp"
 #include "study_report.hpp"
 #include "tsi/error.hpp"
 #include "tsi/fft.hpp"
@@ -486,12 +487,7 @@ int mpi_study_command(PluginLoader& loader, Registry& registry, const StudyCli& 
 
   const bool tty = isatty(fileno(stderr));
   const auto start = Clock::now();
-  auto progress = [&](size_t done, size_t total) {
-    if (!tty) return;
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    const double estimate = done ? elapsed * static_cast<double>(total - done) / static_cast<double>(done) : 0.0;
-    fmt::print(stderr, "\r  {}/{} done, {:.1f} s elapsed, about {:.0f} s to go   ", done, total, elapsed, estimate);
-  };
+  const StudyProgressFn progress = terminal_progress(tty, start);
   if (cli.jobs > 1) fmt::print(stderr, "tsi: note: --jobs is not used under mpirun; each rank runs one run at a time\n");
   if (tty) fmt::print(stderr, "  {} runs on {} MPI ranks\n", plan->study.runs.size(), ranks);
   std::vector<RunOutcome> outcomes;

@@ -4,11 +4,13 @@
 
 #include <atomic>
 #include <algorithm>
+#include <filesystem>
 #include <future>
 #include <map>
 #include <mutex>
 #include <thread>
 
+#include "config.hpp"
 #include "interrupt.hpp"
 #include "tsi/error.hpp"
 #include "tsi/fft.hpp"
@@ -30,7 +32,9 @@ void parallel_for(size_t n, int jobs, const std::function<void(size_t)>& work) {
   for (auto& t : threads) t.join();
 }
 
-RunOutcome failed_outcome(const StudyRun& run, const std::string& message) {
+}  // namespace
+
+RunOutcome failed_run_outcome(const StudyRun& run, const std::string& message) {
   RunOutcome o;
   o.ok = false;
   o.message = message;
@@ -39,7 +43,31 @@ RunOutcome failed_outcome(const StudyRun& run, const std::string& message) {
   return o;
 }
 
-}  // namespace
+bool claim_study_dir(const std::string& out_dir, const Study& study, bool resume, bool force) {
+  namespace fs = std::filesystem;
+  const fs::path previous = fs::path(out_dir) / "study.json";
+  std::error_code ec;
+  if (fs::exists(previous, ec)) {
+    Json earlier;
+    try {
+      earlier = load_config_file(previous.string()).value("study", Json());
+    } catch (const Error&) {
+      earlier = Json();
+    }
+    if (earlier != study.spec && !force)
+      throw ConfigError(resume ? "--resume" : "--out",
+                        "\"" + out_dir + "\" holds the results of another study (" +
+                            (earlier.is_object() ? earlier.value("title", std::string("untitled")) : "unreadable") +
+                            "); choose another --out, or replace them with --force");
+    if (earlier != study.spec)  // --force: the other study's files go (only what tsi writes)
+      for (const char* name : {"study.json", "table.csv", "convergence.png", "conservation.png", "work_precision.png"})
+        fs::remove(fs::path(out_dir) / name, ec);
+  } else {
+    resume = false;  // nothing to resume
+  }
+  if (!resume) fs::remove_all(fs::path(out_dir) / "runs", ec);
+  return resume;
+}
 
 std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, int jobs,
                                   const StudyProgressFn& progress, const std::string& out_dir,
@@ -104,7 +132,7 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
     const StudyRun& run = study.runs[i];
     const ReferenceSolution* reference = nullptr;
     const auto not_run = [&] {  // not started (its reference may have been cut short too)
-      outcomes[i] = failed_outcome(run, fmt::format("not run: the study was interrupted by signal {}", interrupt_signal()));
+      outcomes[i] = failed_run_outcome(run, fmt::format("not run: the study was interrupted by signal {}", interrupt_signal()));
       outcomes[i].result["status"] = "interrupted";
       tick();
     };
@@ -114,7 +142,7 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
       ready[r].wait();  // taken by a worker before any run was: never a deadlock
       if (interrupted()) return not_run();
       if (!reference_errors[r].empty()) {
-        outcomes[i] = failed_outcome(run, "the reference solution failed: " + reference_errors[r]);
+        outcomes[i] = failed_run_outcome(run, "the reference solution failed: " + reference_errors[r]);
         tick();
         return;
       }
@@ -124,10 +152,10 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
       outcomes[i] = execute_run(run.config, registry, {}, reference,
                                 out_dir.empty() ? std::string() : out_dir + "/runs/" + run.id);
     } catch (const IoError& e) {  // its output directory could not be made or written
-      outcomes[i] = failed_outcome(run, e.what());
+      outcomes[i] = failed_run_outcome(run, e.what());
       outcomes[i].io_error = e.what();
     } catch (const std::exception& e) {
-      outcomes[i] = failed_outcome(run, e.what());
+      outcomes[i] = failed_run_outcome(run, e.what());
     }
     tick();
   });

@@ -19,4 +19,13 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
                                   const StudyProgressFn& progress = {}, const std::string& out_dir = "",
                                   const std::vector<bool>& skip = {});
 
+/// One --out, one study: refuses (ConfigError naming --out, or --resume) an output directory
+/// that holds another study's results, unless `force`, which removes that study's files.
+/// Removes runs/ (a smaller expansion would leave stale ones) unless `resume` and the same
+/// study is there; returns whether its runs/ was kept for resuming.
+bool claim_study_dir(const std::string& out_dir, const Study& study, bool resume = false, bool force = false);
+
+/// A run that did not run (or threw): status failed, with the message.
+RunOutcome failed_run_outcome(const StudyRun& run, const std::string& message);
+
 }  // namespace tsi::app
