@@ -11,6 +11,16 @@ pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
 find_library(FFTW3_THREADS_LIBRARY NAMES fftw3_threads HINTS ${FFTW3_LIBRARY_DIRS} REQUIRED)
 find_package(Threads REQUIRED)
 
+# OpenMP (optional: GCC's libgomp; clang needs libomp-dev): one two-scale run splits a large
+# tau grid over threads (tsi --threads, core/include/tsi/tau_grid_threads.hpp). Without it a
+# run uses one thread and everything else is unchanged.
+find_package(OpenMP COMPONENTS CXX QUIET)
+option(TSI_WITH_OPENMP "Split one run's tau grid over threads (tsi --threads)" ${OpenMP_CXX_FOUND})
+if(TSI_WITH_OPENMP AND NOT OpenMP_CXX_FOUND)
+  message(FATAL_ERROR "TSI_WITH_OPENMP is ON but no OpenMP was found (GCC has it; clang: apt-get install libomp-dev)")
+endif()
+message(STATUS "tsi: threads on the tau grid (OpenMP) ${TSI_WITH_OPENMP}")
+
 # MPI (optional: Debian's libopenmpi-dev): `mpirun -np N tsi study` spreads a study's runs over
 # ranks (apps/tsi/study_mpi.cpp). Without it tsi builds as before; --shard/--merge need no MPI.
 find_package(MPI COMPONENTS CXX QUIET)

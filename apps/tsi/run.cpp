@@ -273,6 +273,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
     write_file_atomically(stream_dir + "/result.json", partial.dump(2) + "\n");  // IoError: an I/O failure
     last_checkpoint = Clock::now();
   };
+  result["threads"] = reformulation->threads();  // on the tau grid (tsi --threads)
   try {
     Vector y = reformulation->prepare(u0);
     const int data_order = reformulation->data_order_reached();

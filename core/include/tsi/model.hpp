@@ -64,6 +64,11 @@ class TSI_API Model {
   /// after the FFTs, this is a sweep's largest cost). The default calls filtered_field with
   /// the stored phases; the shipped models return an object with their tables precomputed.
   virtual std::unique_ptr<TauGridField> bind_tau_grid(const RealVector& taus) const;
+  /// True when every binding from bind_tau_grid owns its work space, so that bindings of
+  /// disjoint ranges of one tau grid may evaluate at the same time on different threads (a
+  /// large two-scale run then splits its grid over threads: tsi --threads). False by default:
+  /// a model whose field shares state (a buffer, a lock, an interpreter) runs on one thread.
+  virtual bool independent_tau_grid_bindings() const { return false; }
   /// J Hess H1(u) z for every column pair (u, z): the field's derivative at u in direction z.
   /// The default is a central difference; models with a closed form should override it.
   virtual void nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef directions,

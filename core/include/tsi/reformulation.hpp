@@ -29,6 +29,9 @@ class TSI_API Reformulation : public Problem {
   /// The order of the prepared data of the last prepare() (two-scale; 0 otherwise): below the
   /// configured order when the asymptotic recursion stopped at its smallest correction.
   virtual int data_order_reached() const { return 0; }
+  /// Threads the reformulation's evaluations use (two-scale on a large tau grid: see
+  /// tsi/tau_grid_threads.hpp; 1 otherwise).
+  virtual int threads() const { return 1; }
 
   const Model& model() const { return *model_; }
 

@@ -1,13 +1,43 @@
 #include "two_scale.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
+
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
 
 #include "remainder.hpp"
 #include "tsi/error.hpp"
 #include "tsi/phase.hpp"
+#include "tsi/tau_grid_threads.hpp"
 
 namespace tsi {
+namespace {
+
+// The tau grid's threads: only for a model whose bindings are independent, never more than
+// the grid has rows (the transforms' parts) or columns.
+int grid_threads(const Model& model, int n_tau) {
+  if (!model.independent_tau_grid_bindings()) return 1;
+  const Index threads = std::min<Index>({tau_grid_threads_for(model.dim() * n_tau), model.dim(), n_tau});
+  return static_cast<int>(std::max<Index>(threads, 1));
+}
+
+#if defined(_OPENMP)
+int thread_index() { return omp_get_thread_num(); }
+int team_size() { return omp_get_num_threads(); }
+void barrier() {
+#pragma omp barrier
+}
+#else
+int thread_index() { return 0; }
+int team_size() { return 1; }
+void barrier() {}
+#endif
+
+}  // namespace
 
 TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order,
                    Repreparation repreparation, bool recursion)
@@ -21,8 +51,9 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
       remainder_(model_remainder(*model_)),
       wave_numbers_(n_tau),
       multipliers_(dim_ * n_tau),
-      fft_(n_tau, static_cast<int>(model_->dim())),
-      field_fft_(n_tau, static_cast<int>(model_->dim())),
+      threads_(grid_threads(*model_, n_tau)),
+      fft_(n_tau, static_cast<int>(model_->dim()), threads_),
+      field_fft_(n_tau, static_cast<int>(model_->dim()), threads_),
       repreparation_(repreparation) {
   if (n_tau <= 0 || n_tau % 2 != 0)
     throw ConfigError("reformulation.n_tau",
@@ -41,10 +72,14 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
     if (remainder_.size()) multipliers_.segment(j * dim_, dim_) += remainder_;
   }
   grid_field_ = model_->bind_tau_grid(taus_);
+  for (int p = 0; p <= threads_; ++p) column_begin_.push_back(static_cast<Index>(n_tau) * p / threads_);
+  for (int p = 0; threads_ > 1 && p < threads_; ++p)
+    column_fields_.push_back(model_->bind_tau_grid(taus_.segment(column_begin_[p], column_begin_[p + 1] - column_begin_[p])));
 }
 
 void TwoScale::nonlinear(double /*t*/, const Vector& y, Vector& out) {
   ++evaluations_;
+  if (threads_ > 1) return nonlinear_threaded(y, out);
   auto grid = fft_.data();
   auto field = field_fft_.data();
   grid = Eigen::Map<const Matrix>(y.data(), dim_, n_tau_);
@@ -53,6 +88,43 @@ void TwoScale::nonlinear(double /*t*/, const Vector& y, Vector& out) {
   field_fft_.forward_unnormalised();
   out.resize(size());
   Eigen::Map<Matrix>(out.data(), dim_, n_tau_) = field * (1.0 / n_tau_);  // the 1/n of the transform
+}
+
+void TwoScale::nonlinear_threaded(const Vector& y, Vector& out) {
+  out.resize(size());
+  auto grid = fft_.data();
+  auto field = field_fft_.data();
+  const Eigen::Map<const Matrix> coefficients(y.data(), dim_, n_tau_);
+  Eigen::Map<Matrix> result(out.data(), dim_, n_tau_);
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads_));
+  // Copies go by columns (contiguous), transforms by rows; every phase reads what the one
+  // before wrote on other threads, hence the barriers. A team smaller than asked for (an
+  // OpenMP limit) takes several parts per thread.
+#if defined(_OPENMP)
+#pragma omp parallel num_threads(threads_)
+#endif
+  {
+    const auto parts = [&](auto&& work) {
+      for (int p = thread_index(); p < threads_; p += team_size()) work(p, column_begin_[p], column_begin_[p + 1] - column_begin_[p]);
+    };
+    parts([&](int, Index c0, Index cn) { grid.middleCols(c0, cn) = coefficients.middleCols(c0, cn); });
+    barrier();
+    parts([&](int p, Index, Index) { fft_.backward_part(p); });
+    barrier();
+    parts([&](int p, Index c0, Index cn) {
+      try {
+        column_fields_[p]->evaluate(grid.middleCols(c0, cn), field.middleCols(c0, cn));
+      } catch (...) {
+        errors[p] = std::current_exception();
+      }
+    });
+    barrier();
+    parts([&](int p, Index, Index) { field_fft_.forward_part(p); });
+    barrier();
+    parts([&](int, Index c0, Index cn) { result.middleCols(c0, cn) = field.middleCols(c0, cn) * (1.0 / n_tau_); });
+  }
+  for (const auto& error : errors)
+    if (error) std::rethrow_exception(error);
 }
 
 void TwoScale::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& dy, Vector& out) {

@@ -48,6 +48,7 @@ class TwoScale final : public Reformulation {
   bool between_steps(long n, double t, Vector& y) override;
   std::vector<double> repreparation_times() const override { return repreparation_times_; }
   int data_order_reached() const override { return data_order_reached_; }
+  int threads() const override { return threads_; }
 
  private:
   /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau).
@@ -78,6 +79,10 @@ class TwoScale final : public Reformulation {
   /// The trigonometric interpolant of coefficients c at tau (Nyquist split half/half).
   Vector evaluate(const Matrix& c, double tau) const;
 
+  /// N on the tau grid split over threads_: each thread transforms its rows and evaluates
+  /// the field on its columns (between barriers); the same numbers as the serial path.
+  void nonlinear_threaded(const Vector& y, Vector& out);
+
   Index dim_;
   int n_tau_;
   int data_order_;
@@ -90,6 +95,9 @@ class TwoScale final : public Reformulation {
   RealVector wave_numbers_;  // k of each Fourier index; the Nyquist index holds n/2
   Vector multipliers_;
   Vector remainder_grid_;  // remainder_ on every tau point (empty without a remainder)
+  int threads_;  // threads on the tau grid (tsi::tau_grid_threads_for); 1: the serial path
+  std::vector<Index> column_begin_;  // threads_ + 1 boundaries of the threads' tau columns
+  std::vector<std::unique_ptr<TauGridField>> column_fields_;  // f_tau on each thread's columns
   FftBatch fft_;        // U's coefficients -> its values on the tau grid
   FftBatch field_fft_;  // f_tau(U) on the grid -> its coefficients: the model writes here
   Repreparation repreparation_;

@@ -98,6 +98,8 @@ class ChargedParticle final : public tsi::Model {
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
     return std::make_unique<GridField>(*this, taus);
   }
+  // Each binding owns its tables and transforms: bindings may run on different threads.
+  bool independent_tau_grid_bindings() const override { return true; }
 
   // f_tau with c = cos(tau_j / 2), s = sin(tau_j / 2) given per column.
   void fused_field(const tsi::RealVector& cos, const tsi::RealVector& sin, MatrixRef u, MatrixRef out) const {

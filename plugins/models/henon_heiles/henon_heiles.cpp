@@ -63,6 +63,8 @@ class HenonHeiles final : public tsi::Model {
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
     return std::make_unique<GridField>(taus);
   }
+  // Each binding owns its tables and transforms: bindings may run on different threads.
+  bool independent_tau_grid_bindings() const override { return true; }
 
   // The three steps of f_tau in one pass: the flow turns (q1, p1) only, so the field needs
   // the turned q1, and its (q1, p1) part, (0, -2 q1 q2), turns back by -tau.

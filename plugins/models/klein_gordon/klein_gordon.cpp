@@ -121,6 +121,8 @@ class KleinGordon final : public tsi::Model {
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
     return std::make_unique<GridField>(*this, taus);
   }
+  // Each binding owns its tables and transforms: bindings may run on different threads.
+  bool independent_tau_grid_bindings() const override { return true; }
 
   // f_tau(c) = e^{-i tau} N(e^{i tau} c) in one pass each way. Since e^{JM tau} is the scalar
   // e^{i tau}, backward(a^{-1} e^{i tau} c) = e^{i tau} g with g = backward(a^{-1} c): the phase

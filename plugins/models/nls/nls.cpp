@@ -93,6 +93,8 @@ class Nls final : public tsi::Model {
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
     return std::make_unique<GridField>(*this, taus);
   }
+  // Each binding owns its tables and transforms: bindings may run on different threads.
+  bool independent_tau_grid_bindings() const override { return true; }
 
   // f_tau in one pass each way: the phases e^{-i m^2 tau} are applied while the states are
   // copied (transposed) into the x-batch, and their conjugates (the flow at -tau) while the

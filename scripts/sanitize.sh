@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# The whole suite under AddressSanitizer + UndefinedBehaviorSanitizer: a Debug build (assertions
+# on, -O1 so that the numerical tests finish in CI's time) in build-sanitize/, then ctest.
+# Any ASan or UBSan report (leaks included) aborts the process that made it, so its test fails.
+#   scripts/sanitize.sh [ctest arguments...]
+# Not instrumented: the Python package (it would need libasan preloaded into the interpreter)
+# and the benchmarks; their tests are not part of this build.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+"$root/scripts/install-deps.sh"
+build="$root/build-sanitize"
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" \
+  -DTSI_SANITIZE=ON -DTSI_BUILD_PYTHON=OFF -DTSI_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" -j "$(nproc)" >&2
+export ASAN_OPTIONS="abort_on_error=1:detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+export LSAN_OPTIONS="suppressions=$root/scripts/lsan-suppressions.txt:print_suppressions=0"
+ctest --test-dir "$build" -j "$(nproc)" --output-on-failure "$@"

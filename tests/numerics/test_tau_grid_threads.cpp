@@ -1,0 +1,152 @@
+// One two-scale run on several threads (tsi/tau_grid_threads.hpp): the tau grid's rows are
+// transformed and its columns evaluated by different threads. The split must not change the
+// answer, must stay off where the model shares state or the grid is small, and a model error
+// on one thread must reach the caller.
+#include <doctest/doctest.h>
+
+#include <stdexcept>
+
+#include "harness.hpp"
+#include "runner/run_command.hpp"
+#include "tsi/error.hpp"
+#include "tsi/tau_grid_threads.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using tsi::Index;
+using tsi::Vector;
+using tsi::test::Harness;
+
+// Restores the default setting however a test case ends.
+struct ThreadSetting {
+  ThreadSetting(int threads, long min_values) { tsi::set_tau_grid_threads(threads, min_values); }
+  ~ThreadSetting() { tsi::set_tau_grid_threads(1); }
+};
+
+// u' = J[(1/eps) M u + grad H1] with a linear grad H1 (so any answer is easy to predict), whose
+// bindings throw on the columns that do not hold tau = 0: on a split grid, a thread other than
+// the first fails.
+class ThrowingModel final : public tsi::Model {
+ public:
+  explicit ThrowingModel(bool independent) : Model(0.1), independent_(independent) {}
+  Index dim() const override { return 64; }
+  bool is_complex() const override { return true; }
+  void linear_flow(const tsi::RealVector&, tsi::MatrixRef) const override {}
+  void nonlinear_field(tsi::ConstMatrixRef u, tsi::MatrixRef out) const override { out = u; }
+  void apply_M(const Vector& u, Vector& out) const override { out = 0.0 * u; }
+  void apply_J(const Vector& u, Vector& out) const override { out = u; }
+  double H1(const Vector&) const override { return 0.0; }
+  Vector initial_value() const override { return Vector::Ones(64); }
+  bool independent_tau_grid_bindings() const override { return independent_; }
+
+  class Field final : public tsi::TauGridField {
+   public:
+    explicit Field(bool holds_zero) : holds_zero_(holds_zero) {}
+    void evaluate(tsi::MatrixRef u, tsi::MatrixRef out) override {
+      if (!holds_zero_) throw std::runtime_error("field failed on a later tau range");
+      out = u;
+    }
+
+   private:
+    bool holds_zero_;
+  };
+  std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
+    ++bindings_;
+    // The whole grid (the serial path, preparation) and the first range evaluate; others throw.
+    return std::make_unique<Field>(taus(0) == 0.0);
+  }
+  mutable int bindings_ = 0;
+
+ private:
+  bool independent_;
+};
+
+Vector evaluate_nonlinear(tsi::Reformulation& r, const Vector& y) {
+  Vector out(y.size());
+  r.nonlinear(0.0, y, out);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("tau grid threads: NLS and Klein-Gordon on two threads give the one-thread field and run") {
+  auto& h = Harness::instance();
+  for (const char* name : {"nls", "klein-gordon"}) {
+    CAPTURE(name);
+    const auto field_and_run = [&](int threads) {
+      ThreadSetting setting(threads, 1);
+      auto model = h.model_with(name, 0.01, {{"n_x", 32}});
+      auto two_scale = h.reformulation("two-scale", model, {{"n_tau", 64}});
+      CHECK(two_scale->threads() == (tsi::tau_grid_threads_available() ? threads : 1));
+      const Vector y = two_scale->prepare(model->initial_value());
+      auto se1 = h.scheme("se1");
+      return std::make_pair(evaluate_nonlinear(*two_scale, y), tsi::test::solve(*model, *two_scale, *se1, 0.5, 4));
+    };
+    const auto [field1, run1] = field_and_run(1);
+    const auto [field2, run2] = field_and_run(2);
+    // The same transforms and the same field per column: equal to rounding (measured: equal).
+    CHECK((field1 - field2).norm() <= 1e-14 * field1.norm());
+    CHECK((run1 - run2).norm() <= 1e-14 * run1.norm());
+  }
+}
+
+TEST_CASE("tau grid threads: only large grids of models with independent bindings are split") {
+  auto& h = Harness::instance();
+  {
+    ThreadSetting setting(2, 16384);
+    // 32 x 256 = 8192 values: below the threshold. 64 x 256 = 16384: split.
+    auto small = h.reformulation("two-scale", h.model_with("nls", 0.01, {{"n_x", 32}}), {{"n_tau", 256}});
+    CHECK(small->threads() == 1);
+    auto large = h.reformulation("two-scale", h.model_with("nls", 0.01, {{"n_x", 64}}), {{"n_tau", 256}});
+    CHECK(large->threads() == (tsi::tau_grid_threads_available() ? 2 : 1));
+  }
+  {
+    ThreadSetting setting(2, 1);
+    // Henon-Heiles has 4 rows: never more threads than rows.
+    auto hh = h.reformulation("two-scale", h.model("henon-heiles", 0.01), {{"n_tau", 64}});
+    CHECK(hh->threads() == (tsi::tau_grid_threads_available() ? 2 : 1));
+    ThreadSetting many(8, 1);
+    auto hh8 = h.reformulation("two-scale", h.model("henon-heiles", 0.01), {{"n_tau", 64}});
+    CHECK(hh8->threads() == (tsi::tau_grid_threads_available() ? 4 : 1));
+    // A model that does not declare independent bindings (the default) stays on one thread.
+    auto shared = std::make_shared<ThrowingModel>(false);
+    auto r = h.reformulation("two-scale", shared, {{"n_tau", 64}});
+    CHECK(r->threads() == 1);
+    CHECK(shared->bindings_ == 1);
+  }
+  CHECK_THROWS_AS(tsi::set_tau_grid_threads(0), tsi::ConfigError);
+}
+
+TEST_CASE("tau grid threads: a model error on another thread reaches the caller") {
+  if (!tsi::tau_grid_threads_available()) return;  // nothing runs on another thread
+  auto& h = Harness::instance();
+  ThreadSetting setting(2, 1);
+  auto model = std::make_shared<ThrowingModel>(true);
+  auto r = h.reformulation("two-scale", model, {{"n_tau", 64}});
+  REQUIRE(r->threads() == 2);
+  const Vector y = Vector::Ones(r->size());
+  CHECK_THROWS_WITH(evaluate_nonlinear(*r, y), "field failed on a later tau range");
+  // The team is usable again after the failure (no thread left waiting at a barrier).
+  CHECK_THROWS_WITH(evaluate_nonlinear(*r, y), "field failed on a later tau range");
+}
+
+TEST_CASE("tau grid threads: tsi --threads records its threads and gives the one-thread result") {
+  const tsi::test::TempDir dir("tsi-tau-threads");
+  tsi::Json config = tsi::test::read_json(tsi::test::example_config("nls-se1.json"));
+  config["model"]["n_x"] = 64;  // 64 x 256: split
+  config.erase("reference");
+  const auto path = tsi::test::write_config(dir, config, "nls64.json");
+  const auto one = tsi::test::run_tsi({"--threads", "1", "run", path, "--out", dir / "one"});
+  const auto two = tsi::test::run_tsi({"--threads", "2", "run", path, "--out", dir / "two"});
+  REQUIRE_MESSAGE(one.exit_code == 0, one.describe());
+  REQUIRE_MESSAGE(two.exit_code == 0, two.describe());
+  const tsi::Json a = tsi::test::read_json(fs::path(dir / "one") / "result.json");
+  const tsi::Json b = tsi::test::read_json(fs::path(dir / "two") / "result.json");
+  CHECK(a["threads"] == 1);
+  CHECK(b["threads"] == (tsi::tau_grid_threads_available() ? 2 : 1));
+  CHECK(a["u_final"] == b["u_final"]);
+  const auto bad = tsi::test::run_tsi({"--threads", "0", "run", path, "--out", dir / "bad"});
+  CHECK(bad.exit_code == 2);
+  CHECK(tsi::test::contains(bad.err, "--threads"));
+}
