@@ -5,6 +5,9 @@
 //                          evaluations of N per step)
 //   step_eps/<model>/se1/<eps>  the same at eps = 1 and 1e-6: the cost must not depend on eps
 //   nonlinearity_threads/<model>/2  the nonlinearity with FFTW on two threads (large NLS grids)
+//   tau_threads/<model>_nx<N>/<T>   one SE1 step (h = 1/8, eps = 0.01, n_tau = 256) with the tau
+//                                   grid split over T threads (tsi --threads), N = 16 ... 1024:
+//                                   the ratio T = 1 / T = 2 per size sets the threshold
 // Models and schemes come from the registry, so a new plugin is benchmarked without edits.
 #include <benchmark/benchmark.h>
 
@@ -16,6 +19,7 @@
 #include "tsi/phase.hpp"
 #include "tsi/plugin_loader.hpp"
 #include "tsi/registry.hpp"
+#include "tsi/tau_grid_threads.hpp"
 
 namespace {
 
@@ -118,6 +122,13 @@ void step(benchmark::State& state, Case c, tsi::Json scheme, double eps) {
   state.counters["evaluations"] = static_cast<double>(problem->evaluations()) / static_cast<double>(state.iterations());
 }
 
+// One step with the tau grid on `threads` threads from the first size (threshold 1).
+void step_tau_threads(benchmark::State& state, Case c, int threads) {
+  tsi::set_tau_grid_threads(threads, 1);
+  step(state, c, tsi::Json{{"name", "se1"}}, 0.01);
+  tsi::set_tau_grid_threads(1);
+}
+
 std::vector<Case> paper_cases() {
   std::vector<Case> cases;
   for (const auto* m : registry().models()) {
@@ -158,6 +169,14 @@ int main(int argc, char** argv) {
       benchmark::RegisterBenchmark(("step_eps/" + label(c) + "/se1/" + (eps == 1.0 ? "1" : "1e-6")).c_str(), step, c,
                                    tsi::Json{{"name", "se1"}}, eps);
   }
+  for (const char* model : {"nls", "klein-gordon"})
+    for (int n_x : {16, 32, 64, 128, 256, 512, 1024})
+      for (int threads : {1, 2}) {
+        const Case c{model, {{"n_x", n_x}}, 256};
+        benchmark::RegisterBenchmark(("tau_threads/" + label(c) + "/" + std::to_string(threads)).c_str(),
+                                     step_tau_threads, c, threads)
+            ->UseRealTime();
+      }
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

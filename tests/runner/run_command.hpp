@@ -64,6 +64,17 @@ struct CommandEnv {
   long long file_size_limit = -1;
 };
 
+/// What mpirun needs here: root allowed (CI containers), one machine without network (shared
+/// memory only, no single-copy ptrace transfers, which containers often forbid), more ranks
+/// than cores allowed and no binding. The caller adds its own guard signal.
+inline CommandEnv mpirun_env() {
+  CommandEnv env;
+  env.set = {{"OMPI_ALLOW_RUN_AS_ROOT", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"},
+             {"OMPI_MCA_btl", "self,vader"}, {"OMPI_MCA_btl_vader_single_copy_mechanism", "none"},
+             {"OMPI_MCA_rmaps_base_oversubscribe", "1"}, {"OMPI_MCA_hwloc_base_binding_policy", "none"}};
+  return env;
+}
+
 namespace detail {
 
 inline void close_fd(int& fd) {

@@ -22,12 +22,7 @@ TEST_CASE("study under mpirun -np 2: the table of --jobs 1, each run's files wri
   const auto serial = run_tsi({"study", study, "--out", dir / "serial", "--jobs", "1", "--no-plots"});
   REQUIRE_MESSAGE(serial.exit_code == 1, serial.describe());  // the "stops" runs fail
 
-  CommandEnv env;
-  env.set = {{"OMPI_ALLOW_RUN_AS_ROOT", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"},
-             // One machine, no network: shared memory only, and no single-copy (ptrace) transfers,
-             // which containers often forbid.
-             {"OMPI_MCA_btl", "self,vader"}, {"OMPI_MCA_btl_vader_single_copy_mechanism", "none"},
-             {"OMPI_MCA_rmaps_base_oversubscribe", "1"}, {"OMPI_MCA_hwloc_base_binding_policy", "none"}};
+  CommandEnv env = mpirun_env();
   env.send_signal = SIGTERM;  // a guard: the study takes about a second; a hung mpirun is stopped
   env.signal_after_seconds = 300.0;
   const auto mpi = run_command(TSI_TEST_MPIEXEC, {"-np", "2", "--oversubscribe", "--allow-run-as-root", TSI_TEST_RUNNER,
