@@ -40,3 +40,33 @@ TEST_CASE("study under mpirun -np 2: the table of --jobs 1, each run's files wri
   }
 }
 #endif
+
+#ifdef TSI_TEST_MPIEXEC
+TEST_CASE("study under mpirun: a rank that cannot start is reported and the other ranks run its share") {
+  TempDir dir;
+  const Json spec = {{"kind", "convergence"},
+                     {"title", "mpi-rank-fails"},
+                     {"base", {{"model", {{"name", "henon-heiles"}}}, {"time", {{"t_end", 1.0}}}, {"reference", Json::object()}}},
+                     {"vary", {{"model.eps", {1.0, 1.0 / 64, 1.0 / 4096}}, {"time.h", {0.25, 0.125}}}}};
+  const std::string study = write_config(dir, spec, "study.json");
+  const auto serial = run_tsi({"study", study, "--out", dir / "serial", "--jobs", "1", "--no-plots"});
+  REQUIRE_MESSAGE(serial.exit_code == 0, serial.describe());
+
+  // Two application contexts (MPMD): ranks 0 and 1 read the study, rank 2 is given a file that
+  // does not exist, as a node without the study's files would be.
+  CommandEnv env = mpirun_env();
+  env.send_signal = SIGTERM;
+  env.signal_after_seconds = 300.0;
+  const std::string missing = (fs::path(dir.path()) / "missing.json").string();
+  const auto mpi = run_command(TSI_TEST_MPIEXEC, {"--oversubscribe", "--allow-run-as-root", "-np", "2", TSI_TEST_RUNNER,
+                                                  "study", study, "--out", dir / "mpi", "--no-plots", ":", "-np", "1",
+                                                  TSI_TEST_RUNNER, "study", missing, "--out", dir / "mpi", "--no-plots"},
+                               env);
+  INFO(mpi.describe());
+  CHECK(contains(mpi.err, "rank 2 stopped"));
+  CHECK(contains(mpi.err, "missing.json"));
+  CHECK(mpi.exit_code == 2);  // mpirun passes on the failed rank's code: bad input
+  CHECK(table_without_timings(fs::path(dir / "mpi")) == table_without_timings(fs::path(dir / "serial")));
+  for (const auto& row : read_json(fs::path(dir / "mpi") / "study.json")["table"]) CHECK(row["status"] == "completed");
+}
+#endif
