@@ -25,6 +25,7 @@
 #include "study_report.hpp"
 #include "study_runner.hpp"
 #include "study_spec.hpp"
+#include "tsi/tau_grid_threads.hpp"
 #include "tsi/error.hpp"
 #include "tsi/model.hpp"
 #include "tsi/plugin_loader.hpp"
@@ -305,13 +306,21 @@ py::dict outcome_dict(const tsi::app::RunOutcome& outcome) {
   return d;
 }
 
-py::dict run(const std::string& config_text, const std::string& out_dir) {
+py::dict run(const std::string& config_text, const std::string& out_dir, int threads) {
+  if (threads < 0) throw tsi::ConfigError("threads", "got " + std::to_string(threads) + ", expected at least 1 (or None: all cores)");
   tsi::Registry& registry = tsi::Registry::global();
   const Json raw = parse(config_text, "config");
   if (raw.is_object() && raw.contains("plugins")) tsi::app::load_config_plugins(loader(), raw["plugins"], "./config");
   const Json config = tsi::app::resolve_run_config(raw, registry);
   if (!out_dir.empty()) tsi::app::prepare_output_dir(out_dir);
   bool was_interrupted = false;
+  // As `tsi run`: the run's tau grid on every core unless told otherwise; studies keep one
+  // thread per run (their runs share the cores).
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  tsi::set_tau_grid_threads(threads > 0 ? threads : cores);
+  struct Restore {
+    ~Restore() { tsi::set_tau_grid_threads(1); }
+  } restore;
   const auto outcome = interruptible<tsi::app::RunOutcome>(
       [&] { return tsi::app::execute_run(config, registry); }, was_interrupted);
   if (!out_dir.empty()) tsi::app::write_run_files(out_dir, outcome);
@@ -403,7 +412,7 @@ PYBIND11_MODULE(_tsi, m) {
         py::arg("what") = "");
   m.def("load_plugin", [](const std::string& path) { loader().load(path); }, py::arg("path"));
   m.def("plugin_directory", &tsi::PluginLoader::default_directory);
-  m.def("run", &run, py::arg("config"), py::arg("out") = "");
+  m.def("run", &run, py::arg("config"), py::arg("out") = "", py::arg("threads") = 0);
   m.def("study", &study, py::arg("spec"), py::arg("jobs") = 0, py::arg("overrides") = std::vector<std::string>(),
         py::arg("out") = "");
   m.def("register_model", &register_python_model, py::arg("name"), py::arg("cls"), py::arg("params") = "{}",

@@ -187,11 +187,12 @@ class StudyResult:
         return f"<tsi.StudyResult {self.kind} {self.title!r}: {len(self.rows)} runs, {failed} not completed>"
 
 
-def run(config, *, out=None):
+def run(config, *, out=None, threads=None):
     """Runs one config (a dict, as the JSON of `tsi run`) and returns a RunResult. With `out`,
     also writes result.json and invariants.csv there. A run that fails or blows up part-way
-    is returned with its status and message; bad input raises tsi.ConfigError."""
-    native = _tsi.run(_dumps(config), os.fspath(out) if out else "")
+    is returned with its status and message; bad input raises tsi.ConfigError. `threads`:
+    threads for a large two-scale tau grid, as `tsi --threads` (default: all cores)."""
+    native = _tsi.run(_dumps(config), os.fspath(out) if out else "", int(threads or 0))
     result = RunResult(native)
     if native["interrupted"]:
         raise Interrupted(result)

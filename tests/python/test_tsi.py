@@ -66,6 +66,18 @@ class RunTests(unittest.TestCase):
         self.assertAlmostEqual(r.invariants["err_H"].max(), r.result["invariants"]["H"]["max_rel_error"],
                                delta=1e-6 * r.invariants["err_H"].max())  # the file's 7 digits
 
+    def test_run_on_two_threads_gives_the_one_thread_state(self):
+        nls = {"model": {"name": "nls", "eps": 0.01, "n_x": 64},  # 64 x 256 values: split
+               "reformulation": {"name": "two-scale", "n_tau": 256},
+               "scheme": {"name": "se1"}, "time": {"h": 0.125, "t_end": 0.5}}
+        one, two = tsi.run(nls, threads=1), tsi.run(nls, threads=2)
+        self.assertEqual(one.result["threads"], 1)
+        self.assertIn(two.result["threads"], (1, 2))  # 1 only in a build without OpenMP
+        np.testing.assert_array_equal(one.u_final, two.u_final)
+        with self.assertRaises(tsi.ConfigError) as e:
+            tsi.run(nls, threads=-1)
+        self.assertEqual(e.exception.field, "threads")
+
     @unittest.skipUnless(RUNNER, "TSI_TEST_RUNNER not set")
     def test_run_computes_what_the_cli_computes(self):
         with tempfile.TemporaryDirectory() as tmp:

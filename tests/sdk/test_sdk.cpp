@@ -41,6 +41,7 @@ t::CommandResult configure(const fs::path& source, const fs::path& build, const 
                                    "-DCMAKE_BUILD_TYPE=Release",
                                    "-DCMAKE_PREFIX_PATH=" + prefix.string(),
                                    "-DCMAKE_CXX_COMPILER=" TSI_TEST_CXX_COMPILER,
+                                   "-DCMAKE_CXX_FLAGS=" TSI_TEST_CXX_FLAGS,
                                    "-DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF"};
   if (!std::string(TSI_TEST_MAKE_PROGRAM).empty())
     args.push_back("-DCMAKE_MAKE_PROGRAM=" TSI_TEST_MAKE_PROGRAM);
