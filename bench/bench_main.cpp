@@ -5,9 +5,10 @@
 //                          evaluations of N per step)
 //   step_eps/<model>/se1/<eps>  the same at eps = 1 and 1e-6: the cost must not depend on eps
 //   nonlinearity_threads/<model>/2  the nonlinearity with FFTW on two threads (large NLS grids)
-//   tau_threads/<model>_nx<N>/<T>   one SE1 step (h = 1/8, eps = 0.01, n_tau = 256) with the tau
-//                                   grid split over T threads (tsi --threads), N = 16 ... 1024:
-//                                   the ratio T = 1 / T = 2 per size sets the threshold
+//   tau_threads/<model>_ntau<M>/<T> one SE1 step (h = 1/8, eps = 0.01) with the tau grid split
+//                                   over T threads (tsi --threads): Henon-Heiles and the charged
+//                                   particle (4 x 64), NLS and Klein-Gordon n_x = 16 ... 1024
+//                                   (n_x x 256): the ratio T = 1 / T = 2 per size sets the threshold
 // Models and schemes come from the registry, so a new plugin is benchmarked without edits.
 #include <benchmark/benchmark.h>
 
@@ -169,14 +170,16 @@ int main(int argc, char** argv) {
       benchmark::RegisterBenchmark(("step_eps/" + label(c) + "/se1/" + (eps == 1.0 ? "1" : "1e-6")).c_str(), step, c,
                                    tsi::Json{{"name", "se1"}}, eps);
   }
+  std::vector<Case> threaded = {{"henon-heiles", tsi::Json::object(), 64}, {"cpd", tsi::Json::object(), 64},
+                                 {"nls", {{"n_x", 16}}, 32}, {"nls", {{"n_x", 16}}, 64}};
   for (const char* model : {"nls", "klein-gordon"})
-    for (int n_x : {16, 32, 64, 128, 256, 512, 1024})
-      for (int threads : {1, 2}) {
-        const Case c{model, {{"n_x", n_x}}, 256};
-        benchmark::RegisterBenchmark(("tau_threads/" + label(c) + "/" + std::to_string(threads)).c_str(),
-                                     step_tau_threads, c, threads)
-            ->UseRealTime();
-      }
+    for (int n_x : {16, 32, 64, 128, 256, 512, 1024}) threaded.push_back({model, {{"n_x", n_x}}, 256});
+  for (const Case& c : threaded)
+    for (int threads : {1, 2})
+      benchmark::RegisterBenchmark(
+          ("tau_threads/" + label(c) + "_ntau" + std::to_string(c.n_tau) + "/" + std::to_string(threads)).c_str(),
+          step_tau_threads, c, threads)
+          ->UseRealTime();
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

@@ -8,7 +8,7 @@
 namespace tsi {
 namespace {
 std::atomic<int> threads_setting{1};
-std::atomic<long> threads_min_values{16384};
+std::atomic<long> threads_min_values{4096};
 }  // namespace
 
 void set_tau_grid_threads(int threads, long min_values) {

@@ -94,11 +94,11 @@ TEST_CASE("tau grid threads: NLS and Klein-Gordon on two threads give the one-th
 TEST_CASE("tau grid threads: only large grids of models with independent bindings are split") {
   auto& h = Harness::instance();
   {
-    ThreadSetting setting(2, 16384);
-    // 32 x 256 = 8192 values: below the threshold. 64 x 256 = 16384: split.
-    auto small = h.reformulation("two-scale", h.model_with("nls", 0.01, {{"n_x", 32}}), {{"n_tau", 256}});
+    ThreadSetting setting(2, 4096);  // the default threshold
+    // 16 x 128 = 2048 values: below the threshold. 16 x 256 = 4096: split.
+    auto small = h.reformulation("two-scale", h.model_with("nls", 0.01, {{"n_x", 16}}), {{"n_tau", 128}});
     CHECK(small->threads() == 1);
-    auto large = h.reformulation("two-scale", h.model_with("nls", 0.01, {{"n_x", 64}}), {{"n_tau", 256}});
+    auto large = h.reformulation("two-scale", h.model_with("nls", 0.01, {{"n_x", 16}}), {{"n_tau", 256}});
     CHECK(large->threads() == (tsi::tau_grid_threads_available() ? 2 : 1));
   }
   {
