@@ -164,12 +164,48 @@ TEST_CASE("interrupt: SIGINT at random moments of a run keeps a valid result.jso
                          << " in the reference), " << completed << " completed before the signal");
 }
 
+namespace {
+
+// Six runs of under a second to a few seconds (Henon-Heiles over T = 800, SE1 and SE2, three h)
+// and their reference:
+// a study to interrupt at random moments.
+t::Json six_run_study() {
+  return {{"kind", "convergence"},
+          {"base", {{"model", {{"name", "henon-heiles"}, {"eps", 0.01}}},
+                    {"time", {{"t_end", 800.0}}},
+                    {"reference", t::Json::object()}}},
+          {"vary", {{"scheme.name", {"se1", "se2"}}, {"time.h", {0.05, 0.025, 0.0125}}}}};
+}
+
+// An interrupted (or finished) six_run_study in `out`: study.json and table.csv list every run;
+// a completed run's files are whole, an interrupted run's files (when it has them: a run that
+// never started on an MPI rank has none) hold what it made. Returns whether all completed.
+bool check_study_kept(const t::fs::path& out, bool every_run_has_files, long& finished, long& stopped) {
+  const t::Json study = t::read_json(out / "study.json");
+  REQUIRE(study.at("table").size() == 6);
+  CHECK(t::lines_of(t::read_text(out / "table.csv")).size() == 7);
+  bool all_completed = true;
+  for (const auto& row : study.at("table")) {
+    const std::string id = row.at("id"), status = row.at("status");
+    INFO(id << ": " << row.dump());
+    REQUIRE((status == "completed" || status == "interrupted"));
+    all_completed = all_completed && status == "completed";
+    const t::fs::path run = out / "runs" / id;
+    if (status == "completed") ++finished;
+    else ++stopped;
+    if (status != "completed" && !every_run_has_files && !t::fs::exists(run / "result.json")) continue;
+    const t::Json result = t::read_json(run / "result.json");
+    CHECK(result.at("status") == status);
+    if (status == "completed") CHECK(result.at("error").at("relative").is_number());
+    if (status == "completed" || result.value("steps", 0L) > 0)
+      CHECK(csv_rows(run / "invariants.csv") == result.at("steps").get<long>() + 1);
+  }
+  return all_completed;
+}
+
+}  // namespace
+
 TEST_CASE("interrupt: SIGINT at random moments of a study keeps study.json and every finished run") {
-  const t::Json spec = {{"kind", "convergence"},
-                        {"base", {{"model", {{"name", "henon-heiles"}, {"eps", 0.01}}},
-                                  {"time", {{"t_end", 800.0}}},
-                                  {"reference", t::Json::object()}}},
-                        {"vary", {{"scheme.name", {"se1", "se2"}}, {"time.h", {0.05, 0.025, 0.0125}}}}};
   unsigned seed = 0;
   const std::vector<double> moments = random_moments(3, 3.5, seed);
   MESSAGE("seed " << seed << " (TSI_INTERRUPT_SEED repeats it)");
@@ -179,32 +215,14 @@ TEST_CASE("interrupt: SIGINT at random moments of a study keeps study.json and e
     t::CommandEnv env;
     env.send_signal = SIGINT;
     env.signal_after_seconds = moment;
-    const t::CommandResult r = t::run_tsi(
-        {"study", t::write_config(dir, spec, "study.json"), "--out", dir / "out", "--no-plots", "--jobs", "2"}, env);
+    const t::CommandResult r = t::run_tsi({"study", t::write_config(dir, six_run_study(), "study.json"), "--out",
+                                           dir / "out", "--no-plots", "--jobs", "2"},
+                                          env);
     INFO("SIGINT after " << moment << " s; " << r.describe());
     REQUIRE(r.signal == 0);
     CHECK((r.exit_code == 128 + SIGINT || r.exit_code == 0));  // 0: the study ended before its moment
-    const t::Json study = t::read_json(dir.path() / "out" / "study.json");
-    REQUIRE(study.at("table").size() == 6);
-    if (r.exit_code == 0)
-      for (const auto& row : study.at("table")) CHECK(row.at("status") == "completed");
-    CHECK(t::lines_of(t::read_text(dir.path() / "out" / "table.csv")).size() == 7);
-    for (const auto& row : study.at("table")) {
-      const std::string id = row.at("id"), status = row.at("status");
-      INFO(id << ": " << row.dump());
-      REQUIRE((status == "completed" || status == "interrupted"));
-      const t::fs::path run = dir.path() / "out" / "runs" / id;
-      const t::Json result = t::read_json(run / "result.json");
-      CHECK(result.at("status") == status);
-      if (status == "completed") {
-        ++finished_runs;
-        CHECK(result.at("error").at("relative").is_number());
-        CHECK(csv_rows(run / "invariants.csv") == result.at("steps").get<long>() + 1);
-      } else {
-        ++stopped_runs;
-        if (result.value("steps", 0L) > 0) CHECK(csv_rows(run / "invariants.csv") == result.at("steps").get<long>() + 1);
-      }
-    }
+    const bool all_completed = check_study_kept(dir.path() / "out", true, finished_runs, stopped_runs);
+    if (r.exit_code == 0) CHECK(all_completed);
   }
   MESSAGE(moments.size() << " interrupts: " << finished_runs << " runs completed and kept, " << stopped_runs
                          << " interrupted or not started");
@@ -213,14 +231,9 @@ TEST_CASE("interrupt: SIGINT at random moments of a study keeps study.json and e
 #ifdef TSI_TEST_MPIEXEC
 TEST_CASE("interrupt: SIGINT to mpirun at random moments of an MPI study keeps study.json and every finished run") {
   // Open MPI turns mpirun's SIGINT into SIGTERM for every rank; rank 0 then writes the table.
-  const t::Json spec = {{"kind", "convergence"},
-                        {"base", {{"model", {{"name", "henon-heiles"}, {"eps", 0.01}}},
-                                  {"time", {{"t_end", 800.0}}},
-                                  {"reference", t::Json::object()}}},
-                        {"vary", {{"scheme.name", {"se1", "se2"}}, {"time.h", {0.05, 0.025, 0.0125}}}}};
-  unsigned seed = 0;
   // From 1.5 s on: before that, mpirun may still be starting the ranks (0.4 s measured), and a
   // rank that has not yet installed its handlers dies of the SIGTERM with nothing to write.
+  unsigned seed = 0;
   const std::vector<double> moments = random_moments(3, 3.5, seed);
   MESSAGE("seed " << seed << " (TSI_INTERRUPT_SEED repeats it)");
   long finished_runs = 0, stopped_runs = 0;
@@ -230,37 +243,13 @@ TEST_CASE("interrupt: SIGINT to mpirun at random moments of an MPI study keeps s
     env.send_signal = SIGINT;
     env.signal_after_seconds = 1.5 + moment;
     env.timeout_seconds = 300.0;  // a guard: a hung mpirun is killed, and the checks below fail
-    const t::CommandResult r =
-        t::run_command(TSI_TEST_MPIEXEC, {"-np", "2", "--oversubscribe", "--allow-run-as-root", TSI_TEST_RUNNER, "study",
-                                          t::write_config(dir, spec, "study.json"), "--out", dir / "out", "--no-plots"},
-                       env);
+    const t::CommandResult r = t::run_command(
+        TSI_TEST_MPIEXEC, {"-np", "2", "--oversubscribe", "--allow-run-as-root", TSI_TEST_RUNNER, "study",
+                           t::write_config(dir, six_run_study(), "study.json"), "--out", dir / "out", "--no-plots"},
+        env);
     INFO("SIGINT after " << 1.5 + moment << " s; " << r.describe());
     REQUIRE(r.signal == 0);
-    const t::Json study = t::read_json(dir.path() / "out" / "study.json");
-    REQUIRE(study.at("table").size() == 6);
-    CHECK(t::lines_of(t::read_text(dir.path() / "out" / "table.csv")).size() == 7);
-    bool all_completed = true;
-    for (const auto& row : study.at("table")) {
-      const std::string id = row.at("id"), status = row.at("status");
-      INFO(id << ": " << row.dump());
-      REQUIRE((status == "completed" || status == "interrupted"));
-      all_completed = all_completed && status == "completed";
-      const t::fs::path run = dir.path() / "out" / "runs" / id;
-      if (status == "completed") {
-        ++finished_runs;
-        const t::Json result = t::read_json(run / "result.json");
-        CHECK(result.at("status") == "completed");
-        CHECK(result.at("error").at("relative").is_number());
-        CHECK(csv_rows(run / "invariants.csv") == result.at("steps").get<long>() + 1);
-      } else {
-        ++stopped_runs;
-        if (t::fs::exists(run / "result.json")) {  // started on a rank: what it made is kept
-          const t::Json result = t::read_json(run / "result.json");
-          CHECK(result.at("status") == "interrupted");
-          if (result.value("steps", 0L) > 0) CHECK(csv_rows(run / "invariants.csv") == result.at("steps").get<long>() + 1);
-        }
-      }
-    }
+    const bool all_completed = check_study_kept(dir.path() / "out", false, finished_runs, stopped_runs);
     // mpirun's own code (1 here): not 0 when a run was cut short. A signal that lands after the
     // study was written, while mpirun ends, may still give a non-zero code with every run done.
     if (!all_completed) CHECK(r.exit_code != 0);
