@@ -45,6 +45,37 @@ std::string plot_script_path() {
   return TSI_SOURCE_SCRIPT_DIR "/plot_study.py";
 }
 
+void call_plots(const std::string& out_dir, bool plots) {
+  if (!plots) return;
+  const std::string script = plot_script_path();
+  std::fflush(stdout);  // the script prints too: keep the order
+  const int have_matplotlib = std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1");
+  if (have_matplotlib == 0 && std::filesystem::exists(script)) {
+    const int rc = std::system(("/usr/bin/python3 " + shell_quoted(script) + " " + shell_quoted(out_dir)).c_str());
+    if (rc != 0) fmt::print("  plotting failed; rerun: python3 {} {}\n", script, out_dir);
+  } else {
+    fmt::print("  no plots: install python3-matplotlib, then run: python3 {} {}\n", script, out_dir);
+  }
+}
+
+std::vector<std::string> io_errors_of(const std::vector<StudyRun>& runs, const std::vector<RunOutcome>& outcomes) {
+  std::vector<std::string> errors;
+  for (size_t i = 0; i < runs.size() && i < outcomes.size(); ++i)
+    if (!outcomes[i].io_error.empty()) errors.push_back(runs[i].id + ": " + outcomes[i].message);
+  return errors;
+}
+
+int study_exit_code(const Json& rows, const std::vector<std::string>& io_errors) {
+  if (!io_errors.empty()) {
+    for (size_t k = 0; k < io_errors.size() && k < 8; ++k) spdlog::error("{}", io_errors[k]);
+    if (io_errors.size() > 8) spdlog::error("... and {} more outputs that could not be written", io_errors.size() - 8);
+    return 3;
+  }
+  for (const auto& row : rows)
+    if (row["status"] == "failed") return 1;
+  return 0;
+}
+
 int study_command(PluginLoader& loader, Registry& registry, const std::string& study_path, std::string out_dir,
                   int jobs, const std::vector<std::string>& overrides, bool plots, bool resume, bool force) {
   Json spec = load_config_file(study_path);
@@ -95,34 +126,13 @@ int study_command(PluginLoader& loader, Registry& registry, const std::string& s
 
   const Json rows = study_rows(study, outcomes);
   // Every run's files, then the table; an output that could not be written is exit code 3.
-  std::vector<std::string> io_errors;
-  for (size_t i = 0; i < outcomes.size(); ++i)
-    if (!outcomes[i].io_error.empty()) io_errors.push_back(study.runs[i].id + ": " + outcomes[i].message);
+  std::vector<std::string> io_errors = io_errors_of(study.runs, outcomes);
   for (auto& e : write_study_files(out_dir, study, outcomes, rows, wall, jobs)) io_errors.push_back(std::move(e));
   fmt::print("{}", study_text(study, rows));
   fmt::print("  wall time {:.2f} s on {} threads\n", wall, jobs);
   fmt::print("  written: {0}/table.csv, {0}/study.json, {0}/runs/\n", out_dir);
-
-  const std::string script = plot_script_path();
-  std::fflush(stdout);  // the script prints too: keep the order
-  if (plots) {
-    const int have_matplotlib = std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1");
-    if (have_matplotlib == 0 && std::filesystem::exists(script)) {
-      const int rc = std::system(("/usr/bin/python3 " + shell_quoted(script) + " " + shell_quoted(out_dir)).c_str());
-      if (rc != 0) fmt::print("  plotting failed; rerun: python3 {} {}\n", script, out_dir);
-    } else {
-      fmt::print("  no plots: install python3-matplotlib, then run: python3 {} {}\n", script, out_dir);
-    }
-  }
-  if (!io_errors.empty()) {
-    for (size_t k = 0; k < io_errors.size() && k < 8; ++k) spdlog::error("{}", io_errors[k]);
-    if (io_errors.size() > 8) spdlog::error("... and {} more outputs that could not be written", io_errors.size() - 8);
-    return 3;
-  }
-  // A blow-up is a measured outcome (FD and ME blow up on long runs); an error is not.
-  for (const auto& row : rows)
-    if (row["status"] == "failed") return 1;
-  return 0;
+  call_plots(out_dir, plots);
+  return study_exit_code(rows, io_errors);
 }
 
 }  // namespace tsi::app

@@ -43,25 +43,6 @@ int default_jobs(int jobs) {
   return jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 }
 
-void call_plots(const std::string& out_dir, bool plots) {
-  if (!plots) return;
-  const std::string script = plot_script_path();
-  std::fflush(stdout);  // the script prints too: keep the order
-  const int have_matplotlib = std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1");
-  if (have_matplotlib == 0 && fs::exists(script)) {
-    const int rc = std::system(("/usr/bin/python3 '" + script + "' '" + out_dir + "'").c_str());
-    if (rc != 0) fmt::print("  plotting failed; rerun: python3 {} {}\n", script, out_dir);
-  } else {
-    fmt::print("  no plots: install python3-matplotlib, then run: python3 {} {}\n", script, out_dir);
-  }
-}
-
-int exit_code_of(const Json& rows) {
-  for (const auto& row : rows)
-    if (row["status"] == "failed") return 1;
-  return 0;
-}
-
 // --- one shard --------------------------------------------------------------------------------
 
 int shard_command(PluginLoader& loader, Registry& registry, const StudyCli& cli, const ShardSpec& shard) {
@@ -112,9 +93,15 @@ int shard_command(PluginLoader& loader, Registry& registry, const StudyCli& cli,
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   if (tty) fmt::print(stderr, "\r{:70}\r", "");
 
+  // Every run's files (a run that could not write its own is exit code 3, as without shards).
+  std::vector<std::string> io_errors = io_errors_of(part.runs, outcomes);
   Json runs = Json::array();
   for (size_t k = 0; k < part.runs.size(); ++k) {
-    write_run_files(out_dir + "/runs/" + part.runs[k].id, outcomes[k]);
+    try {
+      write_run_files(out_dir + "/runs/" + part.runs[k].id, outcomes[k]);
+    } catch (const IoError& e) {
+      io_errors.emplace_back(e.what());
+    }
     runs.push_back({{"id", part.runs[k].id}, {"ok", outcomes[k].ok}, {"message", outcomes[k].message}});
   }
   std::error_code ec;
@@ -140,7 +127,7 @@ int shard_command(PluginLoader& loader, Registry& registry, const StudyCli& cli,
   fmt::print("  wall time {:.2f} s on {} threads\n", wall, jobs);
   fmt::print("  written: {0}/{1}, {0}/runs/; merge the {2} shards with: tsi study --merge DIR... --out DIR\n", out_dir,
              shard_file, shard.count);
-  return exit_code_of(rows);
+  return study_exit_code(rows, io_errors);
 }
 
 // --- merging shards ---------------------------------------------------------------------------
@@ -268,7 +255,7 @@ int merge_command(PluginLoader& loader, Registry& registry, const StudyCli& cli)
              std::chrono::duration<double>(Clock::now() - start).count());
   fmt::print("  written: {0}/table.csv, {0}/study.json, {0}/runs/\n", out_dir);
   call_plots(out_dir, cli.plots);
-  return exit_code_of(rows);
+  return study_exit_code(rows, {});
 }
 
 }  // namespace

@@ -94,7 +94,8 @@ ReferenceSolution reference_from_json(const Json& j) {
 }
 
 Json outcome_to_json(const RunOutcome& o) {
-  return {{"result", o.result}, {"csv", o.csv}, {"csv_file", o.csv_file}, {"ok", o.ok}, {"message", o.message}};
+  return {{"result", o.result}, {"csv", o.csv},         {"csv_file", o.csv_file},
+          {"ok", o.ok},         {"message", o.message}, {"io_error", o.io_error}};
 }
 
 RunOutcome outcome_from_json(const Json& j) {
@@ -104,6 +105,7 @@ RunOutcome outcome_from_json(const Json& j) {
   o.csv_file = j["csv_file"];
   o.ok = j["ok"];
   o.message = j["message"];
+  o.io_error = j["io_error"];
   return o;
 }
 
@@ -119,6 +121,7 @@ void write_run(const std::string& out_dir, const StudyRun& run, RunOutcome& outc
     write_run_files(out_dir + "/runs/" + run.id, outcome);
   } catch (const std::exception& e) {
     outcome.ok = false;
+    outcome.io_error = e.what();
     outcome.message = std::string("its files could not be written: ") + e.what();
     outcome.result["status"] = "failed";
     outcome.result["message"] = outcome.message;
@@ -187,6 +190,9 @@ class Worker {
       try {
         outcome = execute_run(run.config, registry_, {}, r >= 0 ? &references_.at(r) : nullptr,
                               plan_.out_dir + "/runs/" + run.id);
+      } catch (const IoError& e) {  // its output directory could not be made or written
+        outcome = failed_run_outcome(run, e.what());
+        outcome.io_error = e.what();
       } catch (const std::exception& e) {
         outcome = failed_run_outcome(run, e.what());
       }
@@ -506,19 +512,8 @@ int mpi_study_command(PluginLoader& loader, Registry& registry, const StudyCli& 
   fmt::print("{}", study_text(plan->study, rows));
   fmt::print("  wall time {:.2f} s on {} MPI ranks\n", wall, ranks);
   fmt::print("  written: {0}/table.csv, {0}/study.json, {0}/runs/\n", plan->out_dir);
-  if (cli.plots) {
-    const std::string script = plot_script_path();
-    std::fflush(stdout);
-    if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0 && std::filesystem::exists(script)) {
-      if (std::system(("/usr/bin/python3 '" + script + "' '" + plan->out_dir + "'").c_str()) != 0)
-        fmt::print("  plotting failed; rerun: python3 {} {}\n", script, plan->out_dir);
-    } else {
-      fmt::print("  no plots: install python3-matplotlib, then run: python3 {} {}\n", script, plan->out_dir);
-    }
-  }
-  for (const auto& row : rows)
-    if (row["status"] == "failed") return 1;
-  return 0;
+  call_plots(plan->out_dir, cli.plots);
+  return study_exit_code(rows, io_errors_of(plan->study.runs, outcomes));
 }
 
 }  // namespace tsi::app

@@ -218,6 +218,70 @@ TEST_CASE("full disk: a study keeps every run's result.json and its table, and e
   check_no_temporaries(dir.path() / "out");
 }
 
+TEST_CASE("full disk: a shard keeps every run's result.json and its shard.json, and exits with 3") {
+  t::TempDir dir;
+  const t::Json spec = {{"kind", "conservation"},
+                        {"base", long_hh_config(10000)},
+                        {"vary", {{"scheme.name", {"se1", "se2"}}}}};
+  t::CommandEnv env;
+  env.file_size_limit = 200000;
+  const t::CommandResult r = t::run_tsi({"study", t::write_config(dir, spec, "study.json"), "--out", dir / "out",
+                                         "--no-plots", "--jobs", "1", "--shard", "1/1"},
+                                        env);
+  INFO(r.describe());
+  CHECK(r.signal == 0);
+  CHECK(r.exit_code == 3);
+  CHECK(t::contains(r.err, "tsi: error: r0001: cannot write " + (dir / "out") +
+                               "/runs/r0001/invariants.csv.partial: File too large"));
+  const t::Json shard = t::read_json(dir.path() / "out" / "shard.json");
+  REQUIRE(shard.at("runs").size() == 2);
+  for (const std::string id : {"r0001", "r0002"}) {
+    const t::fs::path run = dir.path() / "out" / "runs" / id;
+    const t::Json result = t::read_json(run / "result.json");
+    CHECK(result.at("status") == "failed");
+    CHECK(result.at("steps").get<long>() > 100);
+    CHECK(check_valid_csv(run / "invariants.csv") > 100);
+  }
+  check_no_temporaries(dir.path() / "out");
+}
+
+#ifdef TSI_TEST_MPIEXEC
+TEST_CASE("unwritable output: an MPI study whose runs/ cannot be written reports each run and exits with 3") {
+  // A file size limit stops Open MPI itself (its shared-memory files), so the runs' directory
+  // is made unwritable instead: runs/ becomes a file while the study computes its reference.
+  t::TempDir dir;
+  const t::Json spec = {{"kind", "convergence"},
+                        {"base", {{"model", {{"name", "henon-heiles"}, {"eps", 0.01}}},
+                                  {"time", {{"t_end", 100.0}}},
+                                  {"reference", t::Json::object()}}},
+                        {"vary", {{"time.h", {0.05, 0.025}}}}};
+  const std::string out = dir / "out";
+  std::thread blocker([&] {
+    const auto start = std::chrono::steady_clock::now();
+    while (!t::fs::exists(t::fs::path(out) / "runs") && std::chrono::steady_clock::now() - start < std::chrono::seconds(60))
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    std::error_code ec;
+    t::fs::remove_all(t::fs::path(out) / "runs", ec);
+    t::write_text(t::fs::path(out) / "runs", "not a directory\n");
+  });
+  t::CommandEnv env = t::mpirun_env();
+  env.timeout_seconds = 300.0;
+  const t::CommandResult r = t::run_command(TSI_TEST_MPIEXEC,
+                                            {"-np", "2", "--oversubscribe", "--allow-run-as-root", TSI_TEST_RUNNER,
+                                             "study", t::write_config(dir, spec, "study.json"), "--out", out, "--no-plots"},
+                                            env);
+  blocker.join();
+  INFO(r.describe());
+  CHECK(r.signal == 0);
+  CHECK(r.exit_code == 3);  // rank 0's code, passed on by mpirun
+  CHECK(t::contains(r.err, "r0001: "));
+  CHECK(t::contains(r.err, "r0002: "));
+  const t::Json study = t::read_json(t::fs::path(out) / "study.json");
+  REQUIRE(study.at("table").size() == 2);
+  for (const auto& row : study.at("table")) CHECK(row.at("status") == "failed");
+}
+#endif
+
 TEST_CASE("memory: the peak memory of a run with output every step does not grow with its length") {
   // invariants.csv is streamed (at most 64 KiB held), so 10 times the steps and rows take
   // the same memory. Measured with the README's 0.16M and 1.6M steps too.
