@@ -3,14 +3,15 @@
 # on, -O1 so that the numerical tests finish in CI's time) in build-sanitize/, then ctest.
 # Any ASan or UBSan report (leaks included) aborts the process that made it, so its test fails.
 #   scripts/sanitize.sh [ctest arguments...]
-# Not instrumented: the Python package (it would need libasan preloaded into the interpreter)
-# and the benchmarks; their tests are not part of this build.
+# The Python tests run the instrumented extension in the system interpreter, with the
+# sanitizer runtimes preloaded and leak checks off there (tests/CMakeLists.txt). Not built:
+# the benchmarks.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/scripts/install-deps.sh"
 build="$root/build-sanitize"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" \
-  -DTSI_SANITIZE=ON -DTSI_BUILD_PYTHON=OFF -DTSI_BUILD_BENCH=OFF >/dev/null
+  -DTSI_SANITIZE=ON -DTSI_BUILD_PYTHON=ON -DTSI_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build" -j "$(nproc)" >&2
 # Open MPI's own start-up allocations are never freed: scripts/lsan-suppressions.txt matches
 # them by library. For that their stacks must have names: Open MPI keeps its components
