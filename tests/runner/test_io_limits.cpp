@@ -260,9 +260,17 @@ TEST_CASE("unwritable output: an MPI study whose runs/ cannot be written reports
     const auto start = std::chrono::steady_clock::now();
     while (!t::fs::exists(t::fs::path(out) / "runs") && std::chrono::steady_clock::now() - start < std::chrono::seconds(60))
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    std::error_code ec;
-    t::fs::remove_all(t::fs::path(out) / "runs", ec);
-    t::write_text(t::fs::path(out) / "runs", "not a directory\n");
+    // A rank may make runs/ID again between the removal and the write: then try again. Nothing
+    // may throw here (a thread); if runs/ never becomes a file, the checks below fail.
+    for (int attempt = 0; attempt < 1000; ++attempt) {
+      std::error_code ec;
+      t::fs::remove_all(t::fs::path(out) / "runs", ec);
+      try {
+        t::write_text(t::fs::path(out) / "runs", "not a directory\n");
+        if (t::fs::is_regular_file(t::fs::path(out) / "runs", ec)) return;
+      } catch (const std::exception&) {
+      }
+    }
   });
   t::CommandEnv env = t::mpirun_env();
   env.timeout_seconds = 300.0;
