@@ -187,6 +187,22 @@ TEST_CASE("unwritable output: --out removed mid-run gives exit code 3 naming the
   CHECK(t::read_json(t::fs::path(out) / "result.json").at("steps") == 300000);
 }
 
+namespace {
+
+// The two runs of a study stopped by a full disk: failed, with what they made kept whole.
+void check_full_disk_runs(const t::fs::path& out) {
+  for (const std::string id : {"r0001", "r0002"}) {
+    const t::fs::path run = out / "runs" / id;
+    const t::Json result = t::read_json(run / "result.json");
+    CHECK(result.at("status") == "failed");
+    CHECK(result.at("steps").get<long>() > 100);
+    CHECK(check_valid_csv(run / "invariants.csv") > 100);
+  }
+  check_no_temporaries(out);
+}
+
+}  // namespace
+
 TEST_CASE("full disk: a study keeps every run's result.json and its table, and exits with 3") {
   t::TempDir dir;
   const t::Json spec = {{"kind", "conservation"},
@@ -208,14 +224,7 @@ TEST_CASE("full disk: a study keeps every run's result.json and its table, and e
   for (const auto& row : study.at("table")) CHECK(row.at("status") == "failed");
   const std::vector<std::string> table = t::lines_of(t::read_text(dir.path() / "out" / "table.csv"));
   CHECK(table.size() == 3);
-  for (const std::string id : {"r0001", "r0002"}) {
-    const t::fs::path run = dir.path() / "out" / "runs" / id;
-    const t::Json result = t::read_json(run / "result.json");
-    CHECK(result.at("status") == "failed");
-    CHECK(result.at("steps").get<long>() > 100);
-    CHECK(check_valid_csv(run / "invariants.csv") > 100);
-  }
-  check_no_temporaries(dir.path() / "out");
+  check_full_disk_runs(dir.path() / "out");
 }
 
 TEST_CASE("full disk: a shard keeps every run's result.json and its shard.json, and exits with 3") {
@@ -235,14 +244,7 @@ TEST_CASE("full disk: a shard keeps every run's result.json and its shard.json, 
                                "/runs/r0001/invariants.csv.partial: File too large"));
   const t::Json shard = t::read_json(dir.path() / "out" / "shard.json");
   REQUIRE(shard.at("runs").size() == 2);
-  for (const std::string id : {"r0001", "r0002"}) {
-    const t::fs::path run = dir.path() / "out" / "runs" / id;
-    const t::Json result = t::read_json(run / "result.json");
-    CHECK(result.at("status") == "failed");
-    CHECK(result.at("steps").get<long>() > 100);
-    CHECK(check_valid_csv(run / "invariants.csv") > 100);
-  }
-  check_no_temporaries(dir.path() / "out");
+  check_full_disk_runs(dir.path() / "out");
 }
 
 #ifdef TSI_TEST_MPIEXEC
