@@ -189,6 +189,18 @@ TEST_CASE("unwritable output: --out removed mid-run gives exit code 3 naming the
 
 namespace {
 
+// Two runs whose invariants.csv outgrow full_disk()'s 200 kB, as a study.
+t::Json two_long_runs() {
+  return {{"kind", "conservation"}, {"base", long_hh_config(10000)}, {"vary", {{"scheme.name", {"se1", "se2"}}}}};
+}
+
+// A disk that fills at 200 kB per file: RLIMIT_FSIZE, writes beyond it fail with EFBIG.
+t::CommandEnv full_disk() {
+  t::CommandEnv env;
+  env.file_size_limit = 200000;
+  return env;
+}
+
 // The two runs of a study stopped by a full disk: failed, with what they made kept whole.
 void check_full_disk_runs(const t::fs::path& out) {
   for (const std::string id : {"r0001", "r0002"}) {
@@ -205,11 +217,8 @@ void check_full_disk_runs(const t::fs::path& out) {
 
 TEST_CASE("full disk: a study keeps every run's result.json and its table, and exits with 3") {
   t::TempDir dir;
-  const t::Json spec = {{"kind", "conservation"},
-                        {"base", long_hh_config(10000)},
-                        {"vary", {{"scheme.name", {"se1", "se2"}}}}};
-  t::CommandEnv env;
-  env.file_size_limit = 200000;
+  const t::Json spec = two_long_runs();
+  const t::CommandEnv env = full_disk();
   const t::CommandResult r = t::run_tsi(
       {"study", t::write_config(dir, spec, "study.json"), "--out", dir / "out", "--no-plots", "--jobs", "1"}, env);
   INFO(r.describe());
@@ -229,11 +238,8 @@ TEST_CASE("full disk: a study keeps every run's result.json and its table, and e
 
 TEST_CASE("full disk: a shard keeps every run's result.json and its shard.json, and exits with 3") {
   t::TempDir dir;
-  const t::Json spec = {{"kind", "conservation"},
-                        {"base", long_hh_config(10000)},
-                        {"vary", {{"scheme.name", {"se1", "se2"}}}}};
-  t::CommandEnv env;
-  env.file_size_limit = 200000;
+  const t::Json spec = two_long_runs();
+  const t::CommandEnv env = full_disk();
   const t::CommandResult r = t::run_tsi({"study", t::write_config(dir, spec, "study.json"), "--out", dir / "out",
                                          "--no-plots", "--jobs", "1", "--shard", "1/1"},
                                         env);
