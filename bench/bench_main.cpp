@@ -103,13 +103,13 @@ void step(benchmark::State& state, Case c, tsi::Json scheme, double eps) {
                                           {"scheme", scheme}},
                                          registry());
   tsi::Reformulation* problem = a.reformulation.get();
-  tsi::Stepper* stepper = a.stepper.get();
+  const double h = 0.125;
+  tsi::Stepper* stepper = &a.bind(h);
   const tsi::Vector y0 = problem->prepare(a.u0);
   tsi::Vector y = y0;
-  const double h = 0.125;
   long n = 0;
   for (auto _ : state) {
-    stepper->step(*problem, tsi::step_time(n++, h), h, y);
+    stepper->step(tsi::step_time(n++, h), y);
     if (n == 64) {  // stay on a bounded trajectory
       state.PauseTiming();
       y = y0, n = 0;

@@ -138,7 +138,7 @@ Vector reference_model_state(const Json& config, const Registry& registry, doubl
     const double h = ref["h"].is_null() ? t_end / adaptive_chunks : ref["h"].get<double>() / substep_factor;
     const long steps = std::max(1L, std::lround(t_end / h));
     auto last_progress = Clock::now();
-    integrate(*a.reformulation, *a.stepper, y, t_end / static_cast<double>(steps), steps,
+    integrate(a.bind(t_end / static_cast<double>(steps)), y, steps,
               [&](long n, double t, const Vector&) {
                 if (interrupted())
                   throw Error(fmt::format("interrupted by signal {} at t = {:.6g}", interrupt_signal(), t));
@@ -285,7 +285,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
             "(eps = {:g} is too large for its asymptotic expansion beyond that order)",
             data_order, rconf["initial_data_order"].get<int>(), model->eps()));
     }
-    integrate(*reformulation, *stepper, y, h, n_steps, [&](long n, double t, const Vector& state) {
+    integrate(*stepper, y, n_steps, [&](long n, double t, const Vector& state) {
       const bool go_on = recorder.observe(n, t, state);
       if (go_on && interrupted()) {  // kept up to this step, and written as "interrupted"
         status = "interrupted";

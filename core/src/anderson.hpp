@@ -12,6 +12,7 @@ namespace tsi {
 class AndersonSolver final : public FixedPointSolver {
  public:
   explicit AndersonSolver(FixedPointOptions options);
+  double state_vectors() const override { return 4.0 + 2.0 * depth_; }
 
  protected:
   int iterate(Vector& x, FixedPointMap g, double& increment) override;

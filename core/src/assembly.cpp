@@ -156,8 +156,15 @@ Assembly assemble(const Json& resolved, const Registry& registry) {
                                   a.model->has_exact_nonlinear_flow()
                                       ? " (only \"direct\" in model variables does)"
                                       : " (the model has no exact nonlinear flow)"));
-  a.stepper = a.scheme_entry->create(Params(without_name(resolved["scheme"])));
+  a.scheme = a.scheme_entry->create(Params(without_name(resolved["scheme"])));
+  if (resolved.contains("time") && resolved["time"].contains("h") && resolved["time"]["h"].is_number())
+    a.bind(resolved["time"]["h"].get<double>());
   return a;
+}
+
+Stepper& Assembly::bind(double h) {
+  stepper = scheme->bind(*reformulation, h);
+  return *stepper;
 }
 
 Assembly assemble_config(const Json& config, const Registry& registry) {

@@ -4,12 +4,13 @@
 
 namespace tsi {
 
-long integrate(Problem& problem, Stepper& stepper, Vector& y, double h, long n_steps,
-               const StepObserver& observer) {
+long integrate(Stepper& stepper, Vector& y, long n_steps, const StepObserver& observer) {
+  Problem& problem = stepper.problem();
+  const double h = stepper.h();
   stepper.reset();
   if (observer && !observer(0, 0.0, y)) return 0;
   for (long n = 0; n < n_steps; ++n) {
-    stepper.step(problem, step_time(n, h), h, y);
+    stepper.step(step_time(n, h), y);
     if (problem.between_steps(n + 1, step_time(n + 1, h), y)) stepper.reset();
     if (observer && !observer(n + 1, step_time(n + 1, h), y)) return n + 1;
   }

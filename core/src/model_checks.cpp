@@ -271,7 +271,7 @@ void ModelChecks::interface(double eps) {
 Vector ModelChecks::reference(std::shared_ptr<const Model> m, const Vector& u0, double tol) const {
   Assembly a = assembly(registry_.scheme("rk78", "reference.scheme"), "filtered", m->eps(), tol, 200);
   Vector y = a.reformulation->prepare(u0);
-  integrate(*a.reformulation, *a.stepper, y, t_end, 1, {});
+  integrate(a.bind(t_end), y, 1, {});
   return a.reformulation->read_back(y, t_end);
 }
 
@@ -293,7 +293,7 @@ std::vector<double> ModelChecks::errors(const SchemeEntry& scheme, double eps, c
     Vector y = a.reformulation->prepare(a.u0);
     double error = std::numeric_limits<double>::quiet_NaN();
     try {
-      integrate(*a.reformulation, *a.stepper, y, h, n, {});
+      integrate(a.bind(h), y, n, {});
       const Vector x = a.model->to_physical(a.reformulation->read_back(y, step_time(n, h)));
       error = a.model->error_norm(x - x_ref) / a.model->error_norm(x_ref);
     } catch (const Error&) {
@@ -445,8 +445,8 @@ void ModelChecks::symmetry(const SchemeEntry& scheme, double eps) {
   Assembly a = assembly(scheme, "two-scale", eps, 1e-14, 1000);
   const Vector start = a.reformulation->prepare(a.u0);
   Vector y = start;
-  a.stepper->step(*a.reformulation, 0.0, symmetry_step, y);
-  a.stepper->step(*a.reformulation, symmetry_step, -symmetry_step, y);
+  a.bind(symmetry_step).step(0.0, y);
+  a.bind(-symmetry_step).step(symmetry_step, y);
   const double back = max_norm(y - start) / max_norm(start);
   check(fmt::format("{:<8} eps = {:g}: returns to", scheme.info.name, eps), back, symmetry_limit,
         "a symmetric scheme's step h then -h returns the state; if the model is smooth this points at "

@@ -8,6 +8,7 @@ namespace tsi {
 class PicardSolver final : public FixedPointSolver {
  public:
   using FixedPointSolver::FixedPointSolver;
+  double state_vectors() const override { return 1.0; }
 
  protected:
   int iterate(Vector& x, FixedPointMap g, double& increment) override {

@@ -66,6 +66,7 @@ void check_layout(const std::string& path, const TsiPluginLayout& theirs) {
       {"tsi::StepperTraits", &TsiPluginLayout::stepper_traits},
       {"tsi::Model", &TsiPluginLayout::model},
       {"tsi::Stepper", &TsiPluginLayout::stepper},
+      {"tsi::Scheme", &TsiPluginLayout::scheme},
       {"tsi::Params", &TsiPluginLayout::params},
       {"tsi::Vector", &TsiPluginLayout::vector},
       {"tsi::Json", &TsiPluginLayout::json},

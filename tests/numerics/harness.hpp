@@ -45,7 +45,7 @@ class Harness {
 
   /// A scheme, its parameters completed for `model` on the two-scale reformulation (SE2's
   /// nodes depend on the model: without a model it refuses to guess).
-  std::unique_ptr<Stepper> scheme(const std::string& name, const Json& params = Json::object(),
+  std::unique_ptr<Scheme> scheme(const std::string& name, const Json& params = Json::object(),
                                   const std::string& model = "") const {
     const auto& e = registry_.scheme(name);
     Json resolved = resolve_params(e.info.params, params, "scheme");
@@ -87,10 +87,10 @@ inline std::vector<const SchemeEntry*> second_order_schemes() {
 }
 
 /// u(t_end) in physical variables: n steps of size t_end / n from the model's u0.
-inline Vector solve(const Model& model, Reformulation& reformulation, Stepper& stepper, double t_end, long n) {
+inline Vector solve(const Model& model, Reformulation& reformulation, const Scheme& scheme, double t_end, long n) {
   Vector y = reformulation.prepare(model.initial_value());
   const double h = t_end / static_cast<double>(n);
-  integrate(reformulation, stepper, y, h, n, {});
+  integrate(*scheme.bind(reformulation, h), y, n, {});
   return model.to_physical(reformulation.read_back(y, step_time(n, h)));
 }
 

@@ -268,7 +268,7 @@ TEST_CASE("cpd: over T = 200 at eps = 0.5, SE1 keeps the energy error small whil
     auto stepper = h.scheme(name, tsi::Json::object(), "cpd");
     Vector y = two_scale->prepare(u0);
     double err_H = 0.0;
-    tsi::integrate(*two_scale, *stepper, y, 0.2, 1000, [&](long, double t, const Vector& state) {
+    tsi::integrate(*stepper->bind(*two_scale, 0.2), y, 1000, [&](long, double t, const Vector& state) {
       const double e = std::abs(model->energy(two_scale->read_back(state, t)) - H0) / std::abs(H0);
       err_H = std::isfinite(e) ? std::max(err_H, e) : HUGE_VAL;
       return std::isfinite(e);
@@ -334,7 +334,7 @@ TEST_CASE("cpd: the declared magnetic moment mu, adiabatic: O(eps^2) relative ch
     const double mu0 = mu(u0), I0 = model->oscillatory_energy(u0);
     Changes c;
     Vector y = two_scale->prepare(u0);
-    tsi::integrate(*two_scale, *se1, y, 0.2, 10000, [&](long n, double t, const Vector& state) {
+    tsi::integrate(*se1->bind(*two_scale, 0.2), y, 10000, [&](long n, double t, const Vector& state) {
       const Vector u = two_scale->read_back(state, t);
       c.mu = std::max(c.mu, std::abs(mu(u) - mu0) / mu0);
       c.I = std::max(c.I, std::abs(model->oscillatory_energy(u) - I0) / I0);

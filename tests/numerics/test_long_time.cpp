@@ -30,7 +30,7 @@ EnergyRecord energy_error(const tsi::SchemeEntry& scheme) {
   const double H0 = model->energy(u0);
   Vector y = two_scale->prepare(u0);
   EnergyRecord record;
-  tsi::integrate(*two_scale, *stepper, y, 0.2, 1000, [&](long, double t, const Vector& state) {
+  tsi::integrate(*stepper->bind(*two_scale, 0.2), y, 1000, [&](long, double t, const Vector& state) {
     record.t.push_back(t);
     record.err_H.push_back(std::abs(model->energy(two_scale->read_back(state, t)) - H0) / std::abs(H0));
     return true;

@@ -276,7 +276,7 @@ TEST_CASE("nls: symmetric schemes nearly conserve mass and energy over T = 200, 
     auto stepper = h.scheme(name, tsi::Json::object(), "nls");
     Vector y = two_scale->prepare(u0);
     double err_m = 0.0, err_H = 0.0, err_m_half = 0.0;
-    tsi::integrate(*two_scale, *stepper, y, 0.2, 1000, [&](long n, double t, const Vector& state) {
+    tsi::integrate(*stepper->bind(*two_scale, 0.2), y, 1000, [&](long n, double t, const Vector& state) {
       const Vector u = two_scale->read_back(state, t);
       const double em = std::abs(model->mass(u) - m0) / m0, eH = std::abs(model->energy(u) - H0) / H0;
       if (!std::isfinite(em) || !std::isfinite(eH)) {
@@ -336,7 +336,7 @@ TEST_CASE("nls: the declared momentum P is Im int conj(u) u_x dx, kept by the co
     const double P0 = P.value(u0), H0 = model->energy(u0);
     double change = 0.0, err_H = 0.0, agreement = 0.0;
     Vector y = direct->prepare(u0);
-    tsi::integrate(*direct, *rk78, y, 0.05, 20, [&](long, double t, const Vector& state) {
+    tsi::integrate(*rk78->bind(*direct, 0.05), y, 20, [&](long, double t, const Vector& state) {
       const Vector u = direct->read_back(state, t);
       change = std::max(change, std::abs(P.value(u) - P0) / std::abs(P0));
       err_H = std::max(err_H, std::abs(model->energy(u) - H0) / std::abs(H0));

@@ -70,9 +70,9 @@ TEST_CASE("one SE1 step with h and one with -h return the two-scale state") {
       auto se1 = h.scheme("se1", {{"tol", 1e-15}, {"max_iter", 500}});
       const Vector start = two_scale->prepare(model->initial_value());
       Vector y = start;
-      se1->step(*two_scale, 0.0, step, y);
+      se1->bind(*two_scale, step)->step(0.0, y);
       const double moved = tsi::max_norm(y - start);
-      se1->step(*two_scale, step, -step, y);
+      se1->bind(*two_scale, -step)->step(step, y);
       CAPTURE(eps);
       CAPTURE(step);
       CHECK(moved > 1e-3);  // the step did something

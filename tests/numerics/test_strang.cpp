@@ -77,9 +77,9 @@ TEST_CASE("strang: a step with h then -h returns the state") {
       auto strang = h.scheme("strang");
       const Vector start = model->initial_value();
       Vector y = start;
-      strang->step(*direct, 0.0, 0.1, y);
+      strang->bind(*direct, 0.1)->step(0.0, y);
       const double moved = tsi::max_norm(y - start) / tsi::max_norm(start);
-      strang->step(*direct, 0.1, -0.1, y);
+      strang->bind(*direct, -0.1)->step(0.1, y);
       const double back = tsi::max_norm(y - start) / tsi::max_norm(start);
       CAPTURE(name);
       CAPTURE(eps);
@@ -104,7 +104,7 @@ TEST_CASE("strang: refuses a problem without exact flows before anything runs") 
   // NLS has one: the same selection assembles.
   tsi::Json nls = selection;
   nls["model"] = {{"name", "nls"}, {"eps", 0.1}};
-  CHECK(h.assemble(nls).stepper != nullptr);
+  CHECK(h.assemble(nls).scheme != nullptr);
   // The other reformulations are refused by the registry's compatibility check.
   const auto& registry = h.registry();
   CHECK_THROWS_AS(registry.check_compatible(registry.scheme("strang"), registry.reformulation("two-scale")),

@@ -1,6 +1,7 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "tsi/types.hpp"
 
@@ -52,6 +53,27 @@ inline void diagonal_combination(const Vector& d1, const Vector& x1, const Vecto
 inline void diagonal_combination(const Vector& d1, const Vector& x1, const Vector& d2, const Vector& x2,
                                  const Vector& d3, const Vector& x3, Vector& out) {
   out = d1.cwiseProduct(x1) + d2.cwiseProduct(x2) + d3.cwiseProduct(x3);
+}
+
+/// out = start + sum_j d_j . x_j over k pairs (start may be null: none), in one pass over
+/// memory (SUNDIALS' N_VLinearCombination, with diagonal coefficients): the terms accumulate
+/// in a block of entries that stays in cache, in the order given. out may alias start or any x_j.
+inline void diagonal_linear_combination(const Vector* start, std::span<const Vector* const> d,
+                                        std::span<const Vector* const> x, Vector& out) {
+  const Index n = start ? start->size() : x.front()->size();
+  out.resize(n);
+  constexpr Index block = 256;
+  Eigen::Matrix<Complex, block, 1> sum;
+  for (Index b = 0; b < n; b += block) {
+    const Index m = std::min(block, n - b);
+    auto acc = sum.head(m);
+    if (start)
+      acc = start->segment(b, m);
+    else
+      acc.setZero();
+    for (size_t j = 0; j < x.size(); ++j) acc += d[j]->segment(b, m).cwiseProduct(x[j]->segment(b, m));
+    out.segment(b, m) = acc;
+  }
 }
 
 /// Re <x, y> = Re sum conj(x_i) y_i: the inner product of the state as a real vector.

@@ -24,8 +24,13 @@ struct TSI_API Assembly {
   StepperTraits traits;  ///< the scheme's traits with its resolved parameters (scheme_traits)
   std::shared_ptr<const Model> model;
   std::unique_ptr<Reformulation> reformulation;
+  std::unique_ptr<Scheme> scheme;
+  /// The scheme bound to the reformulation: by assemble when the config has time.h, else by bind.
   std::unique_ptr<Stepper> stepper;
   Vector u0;  ///< the initial value in model variables (model.u0 in physical variables, or the model's own)
+
+  /// Binds the scheme to the reformulation and step size h (replacing any earlier binding).
+  Stepper& bind(double h);
 };
 
 /// Builds model, reformulation and scheme from a resolved selection (resolve_selection) and

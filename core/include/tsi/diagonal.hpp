@@ -1,4 +1,6 @@
 #pragma once
+#include <span>
+
 #include "tsi/types.hpp"
 
 namespace tsi {
@@ -9,6 +11,17 @@ template <class F>
 void diagonal_function(const Vector& lambda, double scale, F&& f, Vector& out) {
   out.resize(lambda.size());
   for (Index i = 0; i < lambda.size(); ++i) out(i) = f(scale * lambda(i));
+}
+
+/// outs[j]_i = f(scale * lambda_i)[j] for a function with several values per point (the
+/// weights of an exponential multistep or collocation scheme), each out sized like lambda.
+template <class F>
+void diagonal_functions(const Vector& lambda, double scale, F&& f, std::span<Vector* const> outs) {
+  for (Vector* out : outs) out->resize(lambda.size());
+  for (Index i = 0; i < lambda.size(); ++i) {
+    const auto values = f(scale * lambda(i));
+    for (size_t j = 0; j < outs.size(); ++j) (*outs[j])(i) = values[j];
+  }
 }
 
 }  // namespace tsi

@@ -12,9 +12,8 @@ namespace tsi {
 using StepObserver = std::function<bool(long n, double t, const Vector& y)>;
 
 /// The time loop, apart from the steppers (as Boost.Odeint's integrate_const): n_steps
-/// steps of size h from t = 0, with t_n = n h computed, never accumulated.
-/// Returns the number of steps taken.
-TSI_API long integrate(Problem& problem, Stepper& stepper, Vector& y, double h, long n_steps,
-                       const StepObserver& observer);
+/// steps of the bound stepper's size h from t = 0 on its problem, with t_n = n h computed,
+/// never accumulated. Returns the number of steps taken.
+TSI_API long integrate(Stepper& stepper, Vector& y, long n_steps, const StepObserver& observer);
 
 }  // namespace tsi

@@ -43,6 +43,8 @@ class TSI_API FixedPointSolver {
 
   const SolverStats& stats() const { return stats_; }
   const FixedPointOptions& options() const { return options_; }
+  /// Work vectors of the iterate's size the solver keeps (Picard 1, Anderson 4 + 2 depth).
+  virtual double state_vectors() const = 0;
 
  protected:
   /// One solve: returns the number of sweeps, or -1 when max_iter did not reach tol.
@@ -51,6 +53,24 @@ class TSI_API FixedPointSolver {
  private:
   FixedPointOptions options_;
   SolverStats stats_;
+};
+
+/// Where an implicit stage's iteration starts (a part of its own, apart from the scheme and
+/// the solver): the previous step's stage values (guess "previous", an O(h^2) predictor)
+/// once a step has been taken since the last reset, else the linear part alone.
+class TSI_API StageGuess {
+ public:
+  explicit StageGuess(const FixedPointOptions& options) : use_previous_(options.guess == "previous") {}
+  /// True when the scheme should start from its previous stage values.
+  bool from_previous() const { return use_previous_ && have_previous_; }
+  /// A step has stored its stage values.
+  void stored() { have_previous_ = true; }
+  /// A new trajectory: no previous stage values.
+  void reset() { have_previous_ = false; }
+
+ private:
+  bool use_previous_;
+  bool have_previous_ = false;
 };
 
 /// The solver the options ask for (Picard or Anderson).

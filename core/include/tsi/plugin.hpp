@@ -13,7 +13,7 @@
 /// order, the ABI version, the size of TsiPluginInfo, the tsi major version and the layout of
 /// every structure the plugin exchanges with tsi, before it calls register_fn.
 /// What is stable and what bumps the version: docs/plugin-abi.md.
-inline constexpr std::uint32_t TSI_PLUGIN_ABI_VERSION = 7;
+inline constexpr std::uint32_t TSI_PLUGIN_ABI_VERSION = 8;
 
 extern "C" {
 
@@ -35,6 +35,7 @@ struct TsiPluginLayout {
   TsiTypeLayout stepper_traits;       ///< tsi::StepperTraits
   TsiTypeLayout model;                ///< tsi::Model
   TsiTypeLayout stepper;              ///< tsi::Stepper
+  TsiTypeLayout scheme;               ///< tsi::Scheme
   TsiTypeLayout params;               ///< tsi::Params
   TsiTypeLayout vector;               ///< tsi::Vector (Eigen::VectorXcd)
   TsiTypeLayout json;                 ///< tsi::Json (nlohmann::json)
@@ -77,6 +78,7 @@ constexpr TsiPluginLayout tsi_plugin_layout() {
           layout_of<tsi::StepperTraits>(),
           layout_of<tsi::Model>(),
           layout_of<tsi::Stepper>(),
+          layout_of<tsi::Scheme>(),
           layout_of<tsi::Params>(),
           layout_of<tsi::Vector>(),
           layout_of<tsi::Json>(),

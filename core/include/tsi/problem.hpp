@@ -14,6 +14,9 @@ class TSI_API Problem {
 
   /// Number of (complex) unknowns.
   virtual Index size() const = 0;
+  /// A zero state of this problem's layout: the prototype steppers allocate their
+  /// coefficients and work space from (a device backend allocates on the device here).
+  Vector new_state() const { return Vector::Zero(size()); }
   /// The diagonal of L, or an empty vector when L is not diagonal in these coordinates.
   virtual const Vector& linear_multipliers() const = 0;
   bool has_diagonal_linear_part() const { return linear_multipliers().size() == size(); }

@@ -25,7 +25,8 @@ struct TSI_API EntryInfo {
 using ModelFactory = std::function<std::unique_ptr<Model>(const Params&)>;
 using ReformulationFactory =
     std::function<std::unique_ptr<Reformulation>(std::shared_ptr<const Model>, const Params&)>;
-using StepperFactory = std::function<std::unique_ptr<Stepper>(const Params&)>;
+/// A scheme from its resolved parameters; it is bound to a problem and step size later.
+using SchemeFactory = std::function<std::unique_ptr<Scheme>(const Params&)>;
 
 struct ModelEntry;
 struct ReformulationEntry;
@@ -76,7 +77,7 @@ struct TSI_API ReformulationEntry {
 struct TSI_API SchemeEntry {
   EntryInfo info;
   StepperTraits traits;
-  StepperFactory create;
+  SchemeFactory create;
   CompleteFn complete;  ///< optional (SE2: quadrature nodes from the model's nonlinearity)
   TraitsFn traits_for;  ///< optional: traits that depend on the parameters (else `traits`)
 };

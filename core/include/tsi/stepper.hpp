@@ -1,5 +1,8 @@
 #pragma once
+#include <algorithm>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tsi/export.hpp"
@@ -34,18 +37,73 @@ struct TSI_API SolverStats {
   long not_converged = 0;   ///< stages that hit max_iter without reaching tol
   std::vector<long> sweeps_histogram;  ///< entry k: stages that took k sweeps
   double iterations_mean() const { return solves ? double(iterations) / double(solves) : 0.0; }
+  /// Adds another solver's counters (a composition's parts).
+  void add(const SolverStats& other) {
+    solves += other.solves;
+    iterations += other.iterations;
+    iterations_max = std::max(iterations_max, other.iterations_max);
+    not_converged += other.not_converged;
+    if (sweeps_histogram.size() < other.sweeps_histogram.size()) sweeps_histogram.resize(other.sweeps_histogram.size(), 0);
+    for (size_t k = 0; k < other.sweeps_histogram.size(); ++k) sweeps_histogram[k] += other.sweeps_histogram[k];
+  }
 };
 
-/// Advances a Problem by one step.
+/// A scheme bound to one problem and one step size h (OrdinaryDiffEq's alg_cache,
+/// GeometricIntegrators' integrator): it owns its coefficients and work space, allocated from
+/// the problem's prototype state when it is bound, so a step depends on nothing it was given
+/// before but a multistep history. Another problem or another h is another binding
+/// (Scheme::bind); nothing is cached by key.
 class TSI_API Stepper {
  public:
+  Stepper(Problem& problem, double h) : problem_(problem), h_(h) {}
   virtual ~Stepper() = default;
+  Stepper(const Stepper&) = delete;
+  Stepper& operator=(const Stepper&) = delete;
+
+  Problem& problem() const { return problem_; }
+  /// The step size it was bound to (negative: it steps backwards).
+  double h() const { return h_; }
   /// Forget any history: the next step() starts a new trajectory.
   virtual void reset() {}
-  /// Advance y from t to t + h in place (h < 0 steps backwards).
-  virtual void step(Problem& problem, double t, double h, Vector& y) = 0;
+  /// Advance y from t to t + h() in place.
+  virtual void step(double t, Vector& y) = 0;
   /// Statistics of the implicit stages so far.
   virtual SolverStats stats() const { return {}; }
+  /// Vectors of the problem's size the binding holds (coefficients, stages, history, its
+  /// solver's work space), the state excluded: its memory is this times the state's.
+  virtual double state_vectors() const = 0;
+
+ protected:
+  Problem& problem_;
+  double h_;
 };
+
+/// A scheme: the method with its resolved parameters, apart from any problem. bind() makes
+/// the Stepper for one problem and step size; a composition binds its base once per substep
+/// length, from one Scheme.
+class TSI_API Scheme {
+ public:
+  virtual ~Scheme() = default;
+  virtual std::unique_ptr<Stepper> bind(Problem& problem, double h) const = 0;
+};
+
+/// The common scheme: its steppers are Bound(problem, h, settings).
+template <class Bound, class Settings>
+class BindingScheme final : public Scheme {
+ public:
+  explicit BindingScheme(Settings settings) : settings_(std::move(settings)) {}
+  std::unique_ptr<Stepper> bind(Problem& problem, double h) const override {
+    return std::make_unique<Bound>(problem, h, settings_);
+  }
+
+ private:
+  Settings settings_;
+};
+
+/// A BindingScheme<Bound, Settings> as a Scheme (a registry entry's create).
+template <class Bound, class Settings>
+std::unique_ptr<Scheme> make_scheme(Settings settings) {
+  return std::make_unique<BindingScheme<Bound, Settings>>(std::move(settings));
+}
 
 }  // namespace tsi

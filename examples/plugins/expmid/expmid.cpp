@@ -5,10 +5,11 @@
 // Explicit, second order, not symmetric; on the two-scale problem it needs prepared data of
 // order 2 for an error uniform in eps.
 #include <cmath>
-#include <limits>
 #include <memory>
+#include <variant>
 
 #include "tsi/algebra.hpp"
+#include "tsi/diagonal.hpp"
 #include "tsi/phi.hpp"
 #include "tsi/plugin.hpp"
 
@@ -19,31 +20,27 @@ using tsi::Vector;
 
 class ExpMidpoint final : public tsi::Stepper {
  public:
-  void step(tsi::Problem& problem, double t, double h, Vector& y) override {
-    if (h != h_ || problem.size() != e_full_.size()) prepare(problem, h);
-    problem.nonlinear(t, y, n_);
+  // Bound to one problem and step size h: e^{z/2}, (h/2) phi1(z/2), e^z, h phi1(z) for every
+  // entry of L's diagonal, computed here once, and the work vectors from the problem's prototype.
+  ExpMidpoint(tsi::Problem& problem, double h, std::monostate)
+      : Stepper(problem, h), n_(problem.new_state()), stage_(problem.new_state()) {
+    const Vector& lambda = problem.linear_multipliers();
+    tsi::diagonal_function(lambda, 0.5 * h, [](Complex z) { return std::exp(z); }, e_half_);
+    tsi::diagonal_function(lambda, 0.5 * h, [h](Complex z) { return 0.5 * h * tsi::phi1(z); }, b_half_);
+    tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_full_);
+    tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi1(z); }, b_full_);
+  }
+
+  void step(double t, Vector& y) override {
+    problem_.nonlinear(t, y, n_);
     tsi::algebra::diagonal_combination(e_half_, y, b_half_, n_, stage_);
-    problem.nonlinear(t + 0.5 * h, stage_, n_);
+    problem_.nonlinear(t + 0.5 * h_, stage_, n_);
     tsi::algebra::diagonal_combination(e_full_, y, b_full_, n_, y);
   }
 
- private:
-  // e^{z/2}, (h/2) phi1(z/2), e^z, h phi1(z) for every entry of L's diagonal, once per h.
-  void prepare(const tsi::Problem& problem, double h) {
-    const Vector& lambda = problem.linear_multipliers();
-    const tsi::Index n = lambda.size();
-    e_half_.resize(n), b_half_.resize(n), e_full_.resize(n), b_full_.resize(n);
-    for (tsi::Index i = 0; i < n; ++i) {
-      const Complex z = h * lambda(i);
-      e_half_(i) = std::exp(0.5 * z);
-      b_half_(i) = 0.5 * h * tsi::phi1(0.5 * z);
-      e_full_(i) = std::exp(z);
-      b_full_(i) = h * tsi::phi1(z);
-    }
-    h_ = h;
-  }
+  double state_vectors() const override { return 6.0; }
 
-  double h_ = std::numeric_limits<double>::quiet_NaN();
+ private:
   Vector e_half_, b_half_, e_full_, b_full_, n_, stage_;
 };
 
@@ -56,7 +53,7 @@ void register_expmid(tsi::Registry& registry) {
   entry.traits.needs_diagonal_linear_part = true;
   entry.traits.initial_data_order = 2;
   entry.traits.reformulations = {"filtered", "two-scale"};
-  entry.create = [](const tsi::Params&) { return std::make_unique<ExpMidpoint>(); };
+  entry.create = [](const tsi::Params&) { return tsi::make_scheme<ExpMidpoint>(std::monostate{}); };
   registry.add_scheme(std::move(entry));
 }
 

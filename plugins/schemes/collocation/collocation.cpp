@@ -9,10 +9,11 @@
 // 1e-6), NLS, the charged particle and Klein-Gordon, but at 3.2 on the FPUT example near a
 // step-size resonance (docs/high-order.md).
 #include <cmath>
-#include <limits>
 #include <memory>
 #include <vector>
 
+#include "tsi/algebra.hpp"
+#include "tsi/diagonal.hpp"
 #include "tsi/exponential_weights.hpp"
 #include "tsi/fixed_point.hpp"
 #include "tsi/plugin.hpp"
@@ -25,79 +26,100 @@ using tsi::Vector;
 
 class Collocation final : public tsi::Stepper {
  public:
-  Collocation(int stages, const tsi::FixedPointOptions& options)
-      : s_(stages),
-        weights_of_(tsi::gauss_legendre(stages).nodes),
-        solver_(tsi::make_fixed_point_solver(options)),
-        guess_previous_(options.guess == "previous") {}
+  struct Settings {
+    int stages;
+    tsi::FixedPointOptions options;
+  };
 
-  void reset() override { have_previous_ = false; }
+  Collocation(tsi::Problem& problem, double h, const Settings& settings)
+      : Stepper(problem, h),
+        s_(settings.stages),
+        nodes_(tsi::gauss_legendre(settings.stages).nodes),
+        solver_(tsi::make_fixed_point_solver(settings.options)),
+        guess_(settings.options),
+        stage_(problem.new_state()) {
+    // The coefficients of step size h, with the factor h folded into a and b.
+    const tsi::InterpolatoryWeights weights_of(nodes_);
+    const Vector& lambda = problem.linear_multipliers();
+    const auto scaled = [&](double kappa) {
+      return [&, kappa](Complex z) {
+        std::vector<Complex> w = weights_of(kappa, z);
+        for (Complex& x : w) x *= h;
+        return w;
+      };
+    };
+    a_.assign(s_, std::vector<Vector>(s_));
+    b_.assign(s_, Vector());
+    e_stage_.assign(s_, Vector());
+    n_stage_.assign(s_, problem.new_state());
+    tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_full_);
+    tsi::diagonal_functions(lambda, h, scaled(1.0), pointers(b_));
+    for (int i = 0; i < s_; ++i) {
+      const double c = nodes_[i];
+      tsi::diagonal_function(lambda, h, [c](Complex z) { return std::exp(c * z); }, e_stage_[i]);
+      tsi::diagonal_functions(lambda, h, scaled(c), pointers(a_[i]));
+    }
+    stages_ = Vector::Zero(s_ * problem.size());
+    base_ = stages_;
+    a_terms_.resize(s_), n_terms_.resize(s_), b_terms_.resize(s_ + 1), y_terms_.resize(s_ + 1);
+    for (int j = 0; j < s_; ++j) n_terms_[j] = &n_stage_[j];
+  }
 
-  void step(tsi::Problem& problem, double t, double h, Vector& y) override {
-    if (h != h_ || problem.size() * s_ != stages_.size()) prepare(problem, h);
+  void reset() override { guess_.reset(); }
+
+  void step(double t, Vector& y) override {
     const tsi::Index n = y.size();
     for (int i = 0; i < s_; ++i) base_.segment(i * n, n) = e_stage_[i].cwiseProduct(y);
     // Starting guess: the stages with the previous step's N, else the linear flow alone.
-    stages_ = base_;
-    if (guess_previous_ && have_previous_) stage_map(h, n, stages_);
-    const auto& nodes = weights_of_.nodes();
+    tsi::algebra::copy(base_, stages_);
+    if (guess_.from_previous()) stage_map(n, base_, stages_);
     solver_->solve(stages_, [&](const Vector& x, Vector& out) {
       for (int j = 0; j < s_; ++j) {
-        Vector stage = x.segment(j * n, n);
-        problem.nonlinear(t + nodes[j] * h, stage, n_stage_[j]);
+        stage_ = x.segment(j * n, n);  // preallocated: a copy, no allocation
+        problem_.nonlinear(t + nodes_[j] * h_, stage_, n_stage_[j]);
       }
-      out = base_;
-      stage_map(h, n, out);
+      stage_map(n, base_, out);
     });
-    y = e_full_.cwiseProduct(y);
-    for (int j = 0; j < s_; ++j) y += h * b_[j].cwiseProduct(n_stage_[j]);
-    have_previous_ = true;
+    // y_{n+1} = e^{z} y_n + sum_j h b_j N_j, in one pass.
+    b_terms_[0] = &e_full_, y_terms_[0] = &y;
+    for (int j = 0; j < s_; ++j) b_terms_[j + 1] = &b_[j], y_terms_[j + 1] = &n_stage_[j];
+    tsi::algebra::diagonal_linear_combination(nullptr, b_terms_, y_terms_, y);
+    guess_.stored();
   }
 
   tsi::SolverStats stats() const override { return solver_->stats(); }
-
- private:
-  // out_i += h sum_j a_ij N_j for the stored stage values N_j.
-  void stage_map(double h, tsi::Index n, Vector& out) const {
-    for (int i = 0; i < s_; ++i)
-      for (int j = 0; j < s_; ++j) out.segment(i * n, n) += h * a_[i][j].cwiseProduct(n_stage_[j]);
+  // a (s^2), b, e_stage, N (s each) and e_full, one stage; stages and base are s each.
+  double state_vectors() const override {
+    const double s = s_;
+    return s * s + 3.0 * s + 2.0 + 2.0 * s + s * solver_->state_vectors();
   }
 
-  void prepare(const tsi::Problem& problem, double h) {
-    const Vector& lambda = problem.linear_multipliers();
-    const auto n = lambda.size();
-    const auto& nodes = weights_of_.nodes();
-    a_.assign(s_, std::vector<Vector>(s_, Vector(n)));
-    b_.assign(s_, Vector(n));
-    e_stage_.assign(s_, Vector(n));
-    n_stage_.assign(s_, Vector::Zero(n));
-    e_full_.resize(n);
-    for (tsi::Index k = 0; k < n; ++k) {
-      const Complex z = h * lambda(k);
-      e_full_(k) = std::exp(z);
-      const std::vector<Complex> b = weights_of_(1.0, z);
-      for (int j = 0; j < s_; ++j) b_[j](k) = b[j];
-      for (int i = 0; i < s_; ++i) {
-        e_stage_[i](k) = std::exp(nodes[i] * z);
-        const std::vector<Complex> a = weights_of_(nodes[i], z);
-        for (int j = 0; j < s_; ++j) a_[i][j](k) = a[j];
-      }
+ private:
+  static std::vector<Vector*> pointers(std::vector<Vector>& v) {
+    std::vector<Vector*> p;
+    for (Vector& x : v) p.push_back(&x);
+    return p;
+  }
+
+  // out_i = base_i + sum_j h a_ij N_j for the stored stage values N_j (out may be base).
+  void stage_map(tsi::Index n, const Vector& base, Vector& out) {
+    for (int i = 0; i < s_; ++i) {
+      for (int j = 0; j < s_; ++j) a_terms_[j] = &a_[i][j];
+      // The segments as vectors of their own would be copies: one stage at a time through stage_.
+      stage_ = base.segment(i * n, n);
+      tsi::algebra::diagonal_linear_combination(&stage_, a_terms_, n_terms_, stage_);
+      out.segment(i * n, n) = stage_;
     }
-    stages_.resize(s_ * n);
-    base_.resize(s_ * n);
-    h_ = h;
-    have_previous_ = false;
   }
 
   int s_;
-  tsi::InterpolatoryWeights weights_of_;
+  std::vector<double> nodes_;
   std::unique_ptr<tsi::FixedPointSolver> solver_;
-  bool guess_previous_;
-  bool have_previous_ = false;
-  double h_ = std::numeric_limits<double>::quiet_NaN();
+  tsi::StageGuess guess_;
   std::vector<std::vector<Vector>> a_;
   std::vector<Vector> b_, e_stage_, n_stage_;
-  Vector e_full_, stages_, base_;
+  Vector e_full_, stages_, base_, stage_;
+  std::vector<const Vector*> a_terms_, n_terms_, b_terms_, y_terms_;  // operand lists, allocated once
 };
 
 tsi::StepperTraits traits_of(int stages) {
@@ -127,8 +149,8 @@ void register_collocation(tsi::Registry& registry) {
     return traits_of(p.contains("stages") && p["stages"].is_number_integer() ? p["stages"].get<int>() : 3);
   };
   entry.create = [](const tsi::Params& p) {
-    return std::make_unique<Collocation>(p.has("stages") ? static_cast<int>(p.integer("stages")) : 3,
-                                         tsi::fixed_point_options(p));
+    return tsi::make_scheme<Collocation>(
+        Collocation::Settings{p.has("stages") ? static_cast<int>(p.integer("stages")) : 3, tsi::fixed_point_options(p)});
   };
   registry.add_scheme(std::move(entry));
 }

@@ -2,12 +2,12 @@
 //   triple jump  S_{g1 h} S_{g2 h} S_{g1 h},  g1 = 1 / (2 - 2^{1/3}), g2 = 1 - 2 g1   (order 4)
 //   suzuki5      S_{g h} S_{g h} S_{(1-4g) h} S_{g h} S_{g h},  g = 1 / (4 - 4^{1/3}) (order 4)
 //   yoshida6     S_{w3} S_{w2} S_{w1} S_{w0} S_{w1} S_{w2} S_{w3}, Yoshida 1990 sol. A (order 6)
-// A negative substep is a step with h < 0, which the two-scale multipliers take exactly. Each
-// distinct substep length gets its own base stepper, so a base that caches its coefficients
-// per step size (SE1, SE2) computes them once.
+// A negative substep is a step with h < 0, which the two-scale multipliers take exactly. The
+// base scheme is bound once per distinct substep length w h: the coefficients of each length,
+// computed once.
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -67,42 +67,58 @@ const tsi::SchemeEntry& base_entry(const tsi::Registry& registry, const Json& pa
 
 class Composition final : public tsi::Stepper {
  public:
-  Composition(const tsi::SchemeEntry& base, const tsi::Params& params, const Method& method)
-      : weights_(method.weights) {
-    // One base stepper per distinct weight: each keeps the coefficients of its own h.
-    for (double w : weights_)
-      if (!steppers_.count(w)) steppers_.emplace(w, base.create(params));
+  Composition(tsi::Problem& problem, double h, const tsi::Scheme& base, const Method& method)
+      : Stepper(problem, h) {
+    for (double w : method.weights) {
+      const auto same = std::find(weights_.begin(), weights_.end(), w);
+      if (same == weights_.end()) {
+        weights_.push_back(w);
+        bound_.push_back(base.bind(problem, w * h));
+      }
+      substeps_.push_back(static_cast<size_t>(std::distance(weights_.begin(), std::find(weights_.begin(), weights_.end(), w))));
+    }
   }
 
   void reset() override {
-    for (auto& [w, s] : steppers_) s->reset();
+    for (auto& b : bound_) b->reset();
   }
 
-  void step(tsi::Problem& problem, double t, double h, Vector& y) override {
-    for (double w : weights_) {
-      steppers_.at(w)->step(problem, t, w * h, y);
-      t += w * h;
+  void step(double t, Vector& y) override {
+    for (size_t k : substeps_) {
+      bound_[k]->step(t, y);
+      t += weights_[k] * h_;
     }
   }
 
   tsi::SolverStats stats() const override {
     tsi::SolverStats total;
-    for (const auto& [w, s] : steppers_) {
-      const tsi::SolverStats part = s->stats();
-      total.solves += part.solves;
-      total.iterations += part.iterations;
-      total.iterations_max = std::max(total.iterations_max, part.iterations_max);
-      total.not_converged += part.not_converged;
-      if (total.sweeps_histogram.size() < part.sweeps_histogram.size())
-        total.sweeps_histogram.resize(part.sweeps_histogram.size(), 0);
-      for (size_t k = 0; k < part.sweeps_histogram.size(); ++k) total.sweeps_histogram[k] += part.sweeps_histogram[k];
-    }
+    for (const auto& b : bound_) total.add(b->stats());
+    return total;
+  }
+
+  double state_vectors() const override {
+    double total = 0.0;
+    for (const auto& b : bound_) total += b->state_vectors();
     return total;
   }
 
  private:
-  std::vector<double> weights_;
-  std::map<double, std::unique_ptr<tsi::Stepper>> steppers_;
+  std::vector<double> weights_;                      // the distinct substep fractions
+  std::vector<std::unique_ptr<tsi::Stepper>> bound_;  // the base bound to each
+  std::vector<size_t> substeps_;                     // the method's substeps, as indices
+};
+
+// The composition as a scheme: its base scheme and method; bind() binds the base per length.
+class CompositionScheme final : public tsi::Scheme {
+ public:
+  CompositionScheme(std::unique_ptr<tsi::Scheme> base, const Method& method) : base_(std::move(base)), method_(method) {}
+  std::unique_ptr<tsi::Stepper> bind(tsi::Problem& problem, double h) const override {
+    return std::make_unique<Composition>(problem, h, *base_, method_);
+  }
+
+ private:
+  std::unique_ptr<tsi::Scheme> base_;
+  Method method_;
 };
 
 void register_composition(tsi::Registry& registry) {
@@ -171,8 +187,8 @@ void register_composition(tsi::Registry& registry) {
   entry.create = [reg](const tsi::Params& p) {
     const Json& raw = p.raw();
     const tsi::SchemeEntry& base = base_entry(*reg, raw);
-    return std::make_unique<Composition>(base, tsi::Params(base_params(raw)),
-                                         method_named(raw.value("method", std::string("triple-jump"))));
+    return std::make_unique<CompositionScheme>(base.create(tsi::Params(base_params(raw))),
+                                               method_named(raw.value("method", std::string("triple-jump"))));
   };
   registry.add_scheme(std::move(entry));
 }

@@ -6,13 +6,14 @@
 // values at t - h, ..., t - (r-1) h from the same interpolatory formula towards the past,
 // y(t - k h) = e^{-khL} y + h sum_j beta_j^{(-k)}(hL) N_{-j}, iterated r times from N_{-j} = N_0
 // (each pass gains one order in h), so the history is accurate to O(h^{r+1}).
+#include <array>
 #include <cmath>
-#include <deque>
-#include <limits>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "tsi/algebra.hpp"
+#include "tsi/diagonal.hpp"
 #include "tsi/error.hpp"
 #include "tsi/exponential_weights.hpp"
 #include "tsi/plugin.hpp"
@@ -26,55 +27,63 @@ constexpr int max_order = 6;
 
 class Eab final : public tsi::Stepper {
  public:
-  explicit Eab(int order) : r_(order), weights_of_(past_nodes(order)) {}
-
-  void reset() override { history_.clear(); }
-
-  void step(tsi::Problem& problem, double t, double h, Vector& y) override {
-    if (h != h_ || problem.size() != y.size() || e_.size() != y.size()) prepare(problem, h);
-    if (history_.empty()) start(problem, t, h, y);
-    next_ = e_.cwiseProduct(y);
-    for (int j = 0; j < r_; ++j) next_ += h * weights_[0][j].cwiseProduct(history_[j]);
-    y.swap(next_);
-    history_.pop_back();
-    history_.emplace_front(y.size());
-    problem.nonlinear(t + h, y, history_.front());
-  }
-
- private:
-  // The weights of N_{-j} for the value at kappa h: kappa = 1 the step, -k the start-up.
-  void prepare(const tsi::Problem& problem, double h) {
+  Eab(tsi::Problem& problem, double h, int order) : Stepper(problem, h), r_(order), next_(problem.new_state()) {
+    // The weights of N_{-j} for the value at kappa h: kappa = 1 the step, -k the start-up,
+    // with the factor h folded in.
+    const tsi::InterpolatoryWeights weights_of(past_nodes(r_));
     const Vector& lambda = problem.linear_multipliers();
-    const auto n = lambda.size();
-    weights_.assign(r_, std::vector<Vector>(r_, Vector(n)));
-    exponentials_.assign(r_, Vector(n));
+    weights_.assign(r_, std::vector<Vector>(r_));
+    exponentials_.assign(r_, Vector());
     for (int k = 0; k < r_; ++k) {
       const double kappa = k == 0 ? 1.0 : -static_cast<double>(k);
-      for (tsi::Index i = 0; i < n; ++i) {
-        const Complex z = h * lambda(i);
-        exponentials_[k](i) = std::exp(kappa * z);
-        const std::vector<Complex> w = weights_of_(kappa, z);
-        for (int j = 0; j < r_; ++j) weights_[k][j](i) = w[j];
-      }
+      tsi::diagonal_function(lambda, h, [kappa](Complex z) { return std::exp(kappa * z); }, exponentials_[k]);
+      std::array<Vector*, max_order> outs{};
+      for (int j = 0; j < r_; ++j) outs[j] = &weights_[k][j];
+      tsi::diagonal_functions(
+          lambda, h,
+          [&](Complex z) {
+            std::vector<Complex> w = weights_of(kappa, z);
+            for (Complex& x : w) x *= h;
+            return w;
+          },
+          std::span<Vector* const>(outs.data(), r_));
     }
-    e_ = exponentials_[0];
-    h_ = h;
-    history_.clear();
+    history_.assign(r_, problem.new_state());
+    past_.assign(r_, problem.new_state());
+  }
+
+  void reset() override { started_ = false; }
+
+  void step(double t, Vector& y) override {
+    if (!started_) start(t, y);
+    combine(0, y, next_);
+    y.swap(next_);
+    // The history moves back one place (swaps, no copies) and N_{n+1} takes the front.
+    for (int j = r_ - 1; j > 0; --j) history_[j].swap(history_[j - 1]);
+    problem_.nonlinear(t + h_, y, history_.front());
+  }
+
+  double state_vectors() const override { return (r_ + 1.0) * r_ + 2.0 * r_ + 1.0; }
+
+ private:
+  // out = e^{kappa_k hL} y + sum_j h w_j(kappa_k) N_{-j}, in one pass.
+  void combine(int k, const Vector& y, Vector& out) const {
+    std::array<const Vector*, max_order + 1> d{}, x{};
+    d[0] = &exponentials_[k], x[0] = &y;
+    for (int j = 0; j < r_; ++j) d[j + 1] = &weights_[k][j], x[j + 1] = &history_[j];
+    tsi::algebra::diagonal_linear_combination(nullptr, std::span<const Vector* const>(d.data(), r_ + 1),
+                                              std::span<const Vector* const>(x.data(), r_ + 1), out);
   }
 
   // N at t, t - h, ..., t - (r-1) h, the past values from r passes of the interpolatory formula.
-  void start(tsi::Problem& problem, double t, double h, const Vector& y) {
-    history_.assign(r_, Vector(y.size()));
-    problem.nonlinear(t, y, history_[0]);
-    for (int j = 1; j < r_; ++j) history_[j] = history_[0];
-    std::vector<Vector> past(r_, Vector(y.size()));
+  void start(double t, const Vector& y) {
+    problem_.nonlinear(t, y, history_[0]);
+    for (int j = 1; j < r_; ++j) tsi::algebra::copy(history_[0], history_[j]);
     for (int pass = 0; pass < r_; ++pass) {
-      for (int k = 1; k < r_; ++k) {
-        past[k] = exponentials_[k].cwiseProduct(y);
-        for (int j = 0; j < r_; ++j) past[k] += h * weights_[k][j].cwiseProduct(history_[j]);
-      }
-      for (int k = 1; k < r_; ++k) problem.nonlinear(t - k * h, past[k], history_[k]);
+      for (int k = 1; k < r_; ++k) combine(k, y, past_[k]);
+      for (int k = 1; k < r_; ++k) problem_.nonlinear(t - k * h_, past_[k], history_[k]);
     }
+    started_ = true;
   }
 
   static std::vector<double> past_nodes(int r) {
@@ -84,12 +93,12 @@ class Eab final : public tsi::Stepper {
   }
 
   int r_;
-  tsi::InterpolatoryWeights weights_of_;
-  double h_ = std::numeric_limits<double>::quiet_NaN();
+  bool started_ = false;
   std::vector<std::vector<Vector>> weights_;  // [k][j]: k = 0 the step, k >= 1 the value at -k h
   std::vector<Vector> exponentials_;          // [k]: e^{kappa_k h L}
-  Vector e_, next_;
-  std::deque<Vector> history_;  // N_n, N_{n-1}, ..., N_{n-r+1}
+  Vector next_;
+  std::vector<Vector> history_;  // N_n, N_{n-1}, ..., N_{n-r+1}
+  std::vector<Vector> past_;     // the start-up's values at t - k h
 };
 
 tsi::StepperTraits traits_of_order(int r) {
@@ -119,7 +128,7 @@ void register_eab(tsi::Registry& registry) {
     return traits_of_order(p.contains("order") && p["order"].is_number_integer() ? p["order"].get<int>() : 4);
   };
   entry.create = [](const tsi::Params& p) {
-    return std::make_unique<Eab>(p.has("order") ? static_cast<int>(p.integer("order")) : 4);
+    return tsi::make_scheme<Eab>(p.has("order") ? static_cast<int>(p.integer("order")) : 4);
   };
   registry.add_scheme(std::move(entry));
 }

@@ -11,8 +11,8 @@
 // Without a remainder this is the scheme as published. (Crank-Nicolson on R turns mode j by a
 // phase wrong by (h omega_j)^3/12 per step: on Klein-Gordon it was all of FD's error.)
 #include <cmath>
-#include <limits>
 #include <memory>
+#include <variant>
 
 #include "tsi/algebra.hpp"
 #include "tsi/plugin.hpp"
@@ -25,16 +25,8 @@ using tsi::Vector;
 
 class Fd final : public tsi::Stepper {
  public:
-  void step(tsi::Problem& problem, double t, double h, Vector& y) override {
-    if (h != h_ || problem.size() != inverse_.size()) prepare(problem, h);
-    problem.nonlinear(t, y, n_);
-    algebra::diagonal_combination(inverse_, y, half_inverse_, n_, half_);
-    problem.nonlinear(t + 0.5 * h, half_, n_);
-    algebra::diagonal_combination(cayley_, y, full_inverse_, n_, y);
-  }
-
- private:
-  void prepare(const tsi::Problem& problem, double h) {
+  Fd(tsi::Problem& problem, double h, std::monostate)
+      : Stepper(problem, h), half_(problem.new_state()), n_(problem.new_state()) {
     const Vector& lambda = problem.linear_multipliers();
     const Vector& remainder = problem.remainder_multipliers();
     const tsi::Index n = lambda.size();
@@ -48,10 +40,18 @@ class Fd final : public tsi::Stepper {
       cayley_(i) = half_turn * half_turn * (1.0 + z) * inverse;
       full_inverse_(i) = h * half_turn * inverse;
     }
-    h_ = h;
   }
 
-  double h_ = std::numeric_limits<double>::quiet_NaN();
+  void step(double t, Vector& y) override {
+    problem_.nonlinear(t, y, n_);
+    algebra::diagonal_combination(inverse_, y, half_inverse_, n_, half_);
+    problem_.nonlinear(t + 0.5 * h_, half_, n_);
+    algebra::diagonal_combination(cayley_, y, full_inverse_, n_, y);
+  }
+
+  double state_vectors() const override { return 6.0; }
+
+ private:
   // With E = e^{hR/2} and C = (1 - h L_tau/2)^{-1}: E C, (h/2) E C, E^2 C (1 + h L_tau/2), h E C
   Vector inverse_, half_inverse_, cayley_, full_inverse_;
   Vector half_, n_;
@@ -66,7 +66,7 @@ void register_fd(tsi::Registry& registry) {
   entry.traits.needs_diagonal_linear_part = true;
   entry.traits.initial_data_order = 3;
   entry.traits.reformulations = {"filtered", "two-scale"};
-  entry.create = [](const tsi::Params&) { return std::make_unique<Fd>(); };
+  entry.create = [](const tsi::Params&) { return tsi::make_scheme<Fd>(std::monostate{}); };
   registry.add_scheme(std::move(entry));
 }
 

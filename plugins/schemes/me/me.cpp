@@ -2,8 +2,8 @@
 //   U^{n+1} = e^z U^n + h phi1(z) N(U^n) + h phi2(z) [N(U^n) - N(U^{n-1})],   n >= 1,
 // started by  U^* = e^z U^0 + h phi1(z) N(U^0),  U^1 = U^* + h phi2(z) [N(U^*) - N(U^0)].
 #include <cmath>
-#include <limits>
 #include <memory>
+#include <variant>
 
 #include "tsi/algebra.hpp"
 #include "tsi/diagonal.hpp"
@@ -18,25 +18,29 @@ using tsi::Vector;
 
 class Me final : public tsi::Stepper {
  public:
+  Me(tsi::Problem& problem, double h, std::monostate)
+      : Stepper(problem, h),
+        n_(problem.new_state()),
+        previous_(problem.new_state()),
+        star_(problem.new_state()),
+        n_star_(problem.new_state()) {
+    const Vector& lambda = problem.linear_multipliers();
+    tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_);
+    tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi1(z); }, p1_);
+    tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi2(z); }, p2_);
+    p12_ = p1_ + p2_;
+    minus_p2_ = -p2_;
+  }
+
   void reset() override { has_previous_ = false; }
 
-  void step(tsi::Problem& problem, double t, double h, Vector& y) override {
-    if (h != h_ || problem.size() != e_.size()) {
-      const Vector& lambda = problem.linear_multipliers();
-      tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_);
-      tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi1(z); }, p1_);
-      tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi2(z); }, p2_);
-      p12_ = p1_ + p2_;
-      minus_p2_ = -p2_;
-      has_previous_ = false;  // the two-step formula assumes a constant step: start again
-      h_ = h;
-    }
-    problem.nonlinear(t, y, n_);
+  void step(double t, Vector& y) override {
+    problem_.nonlinear(t, y, n_);
     if (has_previous_) {
       algebra::diagonal_combination(e_, y, p12_, n_, minus_p2_, previous_, y);
     } else {  // the start-up step
       algebra::diagonal_combination(e_, y, p1_, n_, star_);
-      problem.nonlinear(t + h, star_, n_star_);
+      problem_.nonlinear(t + h_, star_, n_star_);
       algebra::axpby(1.0, n_star_, -1.0, n_, n_star_);
       algebra::diagonal_multiply_add(star_, p2_, n_star_, y);
     }
@@ -44,10 +48,12 @@ class Me final : public tsi::Stepper {
     has_previous_ = true;
   }
 
+  double state_vectors() const override { return 9.0; }
+
  private:
-  double h_ = std::numeric_limits<double>::quiet_NaN();
   bool has_previous_ = false;
-  Vector e_, p1_, p2_, p12_, minus_p2_, n_, previous_, star_, n_star_;  // p12 = p1 + p2
+  Vector e_, p1_, p2_, p12_, minus_p2_;  // the coefficients of step size h; p12 = p1 + p2
+  Vector n_, previous_, star_, n_star_;
 };
 
 void register_me(tsi::Registry& registry) {
@@ -60,7 +66,7 @@ void register_me(tsi::Registry& registry) {
   entry.traits.needs_diagonal_linear_part = true;
   entry.traits.initial_data_order = 2;
   entry.traits.reformulations = {"filtered", "two-scale"};
-  entry.create = [](const tsi::Params&) { return std::make_unique<Me>(); };
+  entry.create = [](const tsi::Params&) { return tsi::make_scheme<Me>(std::monostate{}); };
   registry.add_scheme(std::move(entry));
 }
 

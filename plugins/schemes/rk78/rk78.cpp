@@ -45,7 +45,20 @@ using Controlled = odeint::controlled_runge_kutta<odeint::runge_kutta_fehlberg78
 
 class Rk78 final : public tsi::Stepper {
  public:
-  Rk78(double tol, double substeps_per_period) : tol_(tol), substeps_per_period_(substeps_per_period) {}
+  struct Settings {
+    double tol, substeps_per_period;
+  };
+
+  Rk78(tsi::Problem& problem, double h, const Settings& settings)
+      : Stepper(problem, h),
+        tol_(settings.tol),
+        substeps_per_period_(settings.substeps_per_period),
+        hi_(2 * static_cast<size_t>(problem.size())),
+        lo_(hi_.size()),
+        z_(hi_.size()),
+        in_(problem.new_state()),
+        out_(problem.new_state()),
+        controlled_(AnchoredErrorChecker{settings.tol, &hi_}) {}
 
   void reset() override { dt_ = 0.0; }
 
@@ -54,26 +67,25 @@ class Rk78 final : public tsi::Stepper {
   // rounds at ulp(y) per substep; over the 10^6 .. 10^8 substeps of a small-eps run that
   // accumulates (charged particle, eps = 1e-6: 4e-13 in p = 2 eps v - B x, 2e-7 in v, and
   // systematic when the substeps divide the fast period), while z rounds at ulp(z).
-  void step(tsi::Problem& problem, double t, double h, Vector& y) override {
+  void step(double t, Vector& y) override {
+    const double h = h_;
     const auto n = y.size();
     const size_t m = 2 * static_cast<size_t>(n);
-    hi_.resize(m), lo_.assign(m, 0.0), z_.resize(m);
-    in_.resize(n), out_.resize(n);
+    std::fill(lo_.begin(), lo_.end(), 0.0);
     Eigen::Map<Vector>(reinterpret_cast<Complex*>(hi_.data()), n) = y;
     auto system = [&](const State& z, State& dzdt, double time) {
       double* in = reinterpret_cast<double*>(in_.data());
       for (size_t i = 0; i < m; ++i) in[i] = hi_[i] + (lo_[i] + z[i]);
-      problem.rhs(time, in_, out_);
+      problem_.rhs(time, in_, out_);
       dzdt.resize(m);
       Eigen::Map<Vector>(reinterpret_cast<Complex*>(dzdt.data()), n) = out_;
     };
-    Controlled stepper(AnchoredErrorChecker{tol_, &hi_});
-    if (dt_ == 0.0 || dt_ * h < 0.0) dt_ = initial_substep(problem, t, h, y);
+    if (dt_ == 0.0 || dt_ * h < 0.0) dt_ = initial_substep(problem_, t, h, y);
 
     // Elapsed time as an unevaluated sum too: odeint's own t += dt would add a rounding per
     // substep, a phase error of steps * ulp / eps in the fast variable.
     const double t_end = t + h;
-    const double max_dt = problem.fast_period() / substeps_per_period_;
+    const double max_dt = problem_.fast_period() / substeps_per_period_;
     double t_hi = t, t_lo = 0.0;
     for (;;) {
       const double remaining = (t_end - t_hi) - t_lo;
@@ -84,7 +96,7 @@ class Rk78 final : public tsi::Stepper {
       double t_try = t_hi + t_lo;
       const double dt_taken = dt;
       std::fill(z_.begin(), z_.end(), 0.0);
-      bool accepted = stepper.try_step(system, z_, t_try, dt) == odeint::success;
+      bool accepted = controlled_.try_step(system, z_, t_try, dt) == odeint::success;
       if (accepted && !all_finite(z_)) {
         // A NaN error estimate passes odeint's "err > 1" test: refuse the step ourselves.
         dt = 0.1 * dt_taken;
@@ -103,6 +115,10 @@ class Rk78 final : public tsi::Stepper {
     for (size_t i = 0; i < m; ++i) hi_[i] += lo_[i];
     y = Eigen::Map<const Vector>(reinterpret_cast<const Complex*>(hi_.data()), n);
   }
+
+  // The state, its rounding and the deviation (real pairs), the field's argument and value;
+  // odeint's pair holds 13 stages and 3 temporaries more, allocated on its first step.
+  double state_vectors() const override { return 5.0 + 16.0; }
 
  private:
   // hi + lo += x, with the rounding of hi + x carried in lo (Knuth's two-sum).
@@ -132,6 +148,7 @@ class Rk78 final : public tsi::Stepper {
   double dt_ = 0.0;  // the controller's last substep, carried across calls
   State hi_, lo_, z_;
   Vector in_, out_;
+  Controlled controlled_;  // after hi_: its error checker points at it
 };
 
 void register_rk78(tsi::Registry& registry) {
@@ -148,7 +165,9 @@ void register_rk78(tsi::Registry& registry) {
   entry.traits.order = 7;
   entry.traits.adaptive = true;
   entry.traits.reformulations = {"direct", "filtered"};
-  entry.create = [](const tsi::Params& p) { return std::make_unique<Rk78>(p.number("tol"), p.number("substeps_per_period")); };
+  entry.create = [](const tsi::Params& p) {
+    return tsi::make_scheme<Rk78>(Rk78::Settings{p.number("tol"), p.number("substeps_per_period")});
+  };
   registry.add_scheme(std::move(entry));
 }
 

@@ -2,7 +2,6 @@
 //   U^{n+1} = e^{z} U^n + h phi1(z) int_0^1 N((1 - rho) U^n + rho U^{n+1}) d rho,  z = h L,
 // the rho-integral by Gauss-Legendre quadrature, U^{n+1} by fixed-point iteration.
 #include <cmath>
-#include <limits>
 #include <memory>
 
 #include "tsi/algebra.hpp"
@@ -21,23 +20,31 @@ using tsi::Vector;
 
 class Se2 final : public tsi::Stepper {
  public:
-  Se2(const tsi::FixedPointOptions& options, int nodes)
-      : solver_(tsi::make_fixed_point_solver(options)),
-        guess_previous_(options.guess == "previous"),
-        rule_(tsi::gauss_legendre(nodes)) {}
+  struct Settings {
+    tsi::FixedPointOptions options;
+    int nodes;
+  };
 
-  void reset() override { have_previous_ = false; }
+  Se2(tsi::Problem& problem, double h, const Settings& settings)
+      : Stepper(problem, h),
+        solver_(tsi::make_fixed_point_solver(settings.options)),
+        guess_(settings.options),
+        rule_(tsi::gauss_legendre(settings.nodes)),
+        base_(problem.new_state()),
+        next_(problem.new_state()),
+        stage_(problem.new_state()),
+        n_(problem.new_state()),
+        average_(problem.new_state()) {
+    tsi::diagonal_function(problem.linear_multipliers(), h, [](Complex z) { return std::exp(z); }, e_);
+    tsi::diagonal_function(problem.linear_multipliers(), h, [h](Complex z) { return h * tsi::phi1(z); }, b_);
+  }
 
-  void step(tsi::Problem& problem, double t, double h, Vector& y) override {
-    if (h != h_ || problem.size() != e_.size()) {
-      tsi::diagonal_function(problem.linear_multipliers(), h, [](Complex z) { return std::exp(z); }, e_);
-      tsi::diagonal_function(problem.linear_multipliers(), h, [h](Complex z) { return h * tsi::phi1(z); }, b_);
-      h_ = h;
-      have_previous_ = false;
-    }
+  void reset() override { guess_.reset(); }
+
+  void step(double t, Vector& y) override {
     algebra::diagonal_multiply(e_, y, base_);
     // Starting guess: the previous step's averaged N, an O(h^2) predictor.
-    if (guess_previous_ && have_previous_)
+    if (guess_.from_previous())
       algebra::diagonal_multiply_add(base_, b_, average_, next_);
     else
       algebra::copy(base_, next_);
@@ -46,24 +53,24 @@ class Se2 final : public tsi::Stepper {
       for (size_t i = 0; i < rule_.nodes.size(); ++i) {
         const double rho = rule_.nodes[i];
         algebra::axpby(1.0 - rho, y, rho, x, stage_);
-        problem.nonlinear(t + rho * h, stage_, n_);
+        problem_.nonlinear(t + rho * h_, stage_, n_);
         algebra::axpy(rule_.weights[i], n_, average_);
       }
       algebra::diagonal_multiply_add(base_, b_, average_, out);
     });
     algebra::copy(next_, y);
-    have_previous_ = true;
+    guess_.stored();
   }
 
   tsi::SolverStats stats() const override { return solver_->stats(); }
+  double state_vectors() const override { return 7.0 + solver_->state_vectors(); }
 
  private:
   std::unique_ptr<tsi::FixedPointSolver> solver_;
-  bool guess_previous_;
-  bool have_previous_ = false;
+  tsi::StageGuess guess_;
   tsi::QuadratureRule rule_;
-  double h_ = std::numeric_limits<double>::quiet_NaN();
-  Vector e_, b_, base_, next_, stage_, n_, average_;
+  Vector e_, b_;  // the coefficients of step size h
+  Vector base_, next_, stage_, n_, average_;
 };
 
 void register_se2(tsi::Registry& registry) {
@@ -93,7 +100,7 @@ void register_se2(tsi::Registry& registry) {
       throw tsi::ConfigError("scheme.quadrature_nodes",
                              "not set: build the scheme through tsi::assemble, which completes it from the model");
     const int nodes = static_cast<int>(p.integer("quadrature_nodes"));
-    return std::make_unique<Se2>(tsi::fixed_point_options(p), nodes);
+    return tsi::make_scheme<Se2>(Se2::Settings{tsi::fixed_point_options(p), nodes});
   };
   registry.add_scheme(std::move(entry));
 }

@@ -3,6 +3,7 @@
 // Second order and time-symmetric; the classical reference for NLS (the paper's) and the
 // baseline a user would pick when the model's nonlinear part has an exact flow.
 #include <memory>
+#include <variant>
 
 #include "tsi/plugin.hpp"
 
@@ -12,11 +13,15 @@ using tsi::Vector;
 
 class Strang final : public tsi::Stepper {
  public:
-  void step(tsi::Problem& problem, double t, double h, Vector& y) override {
-    problem.linear_flow(0.5 * h, y);
-    problem.nonlinear_flow(t, h, y);
-    problem.linear_flow(0.5 * h, y);
+  Strang(tsi::Problem& problem, double h, std::monostate) : Stepper(problem, h) {}
+
+  void step(double t, Vector& y) override {
+    problem_.linear_flow(0.5 * h_, y);
+    problem_.nonlinear_flow(t, h_, y);
+    problem_.linear_flow(0.5 * h_, y);
   }
+
+  double state_vectors() const override { return 0.0; }
 };
 
 void register_strang(tsi::Registry& registry) {
@@ -30,7 +35,7 @@ void register_strang(tsi::Registry& registry) {
   entry.traits.symmetric = true;
   entry.traits.needs_exact_flows = true;  // refused at configuration time without them
   entry.traits.reformulations = {"direct"};
-  entry.create = [](const tsi::Params&) { return std::make_unique<Strang>(); };
+  entry.create = [](const tsi::Params&) { return tsi::make_scheme<Strang>(std::monostate{}); };
   registry.add_scheme(std::move(entry));
 }
 
