@@ -57,7 +57,7 @@ const ParamSchema& reference_schema() {
 
 const ParamSchema& output_schema() {
   static const ParamSchema schema = {
-      integer_param("every", 1, "write a row of invariants.csv every this many steps")
+      integer_param("every", 1, "record the invariants, the tau monitors and a row of invariants.csv every this many steps (and at the last); other steps only check that the state is finite")
           .check([](const Json& v) { return v.get<long>() >= 1; }, "a positive integer"),
       number_param("checkpoint_seconds", 30.0,
                    "rewrite result.json (status running, the time reached) at most this often while a run goes")

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <limits>
 
+#include <sys/resource.h>
+
 #include "config.hpp"
 #include "interrupt.hpp"
 #include "run_recorder.hpp"
@@ -366,6 +368,16 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   const std::vector<double> reprepared = reformulation->repreparation_times();
   result["repreparations"] = {{"count", reprepared.size()}, {"times", reprepared}};
   result["wall_seconds"] = wall;
+  {
+    // The memory the run's state takes, and the bound stepper's vectors of that size; the
+    // process's peak resident memory (in a study with --jobs, shared by its runs).
+    const double state_bytes = static_cast<double>(reformulation->size()) * static_cast<double>(sizeof(Complex));
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    result["memory"] = {{"state_bytes", state_bytes},
+                        {"stepper_state_vectors", stepper->state_vectors()},
+                        {"process_peak_rss_bytes", static_cast<double>(usage.ru_maxrss) * 1024.0}};
+  }
 
   if (outcome.ok && config.contains("reference")) {
     ReferenceSolution ref;

@@ -9,12 +9,13 @@
 
 namespace tsi::app {
 
-/// What a run records at every step: the invariants H, I, m and their largest relative
-/// changes, the invariants the model declares (Model::invariants) and their largest changes,
-/// the tau roughness, and the rows of invariants.csv. It also watches the run:
-/// a non-finite solution or err_H above monitor.max_err_H stops it (blow-up), and a tau
-/// profile rougher than monitor.tau_roughness_warn, or one whose spread away from its tau
-/// mean grew by monitor.tau_spread_growth_warn, is reported once.
+/// What a run records every output.every steps (and at its last step): the invariants H, I, m
+/// and their largest relative changes over the recorded steps, the invariants the model
+/// declares (Model::invariants) and their largest changes, the tau monitors, and the rows of
+/// invariants.csv. It also watches the run: a non-finite state (checked at every step, one
+/// pass over the state without allocating) or err_H above monitor.max_err_H (at the recorded
+/// steps) stops it (blow-up), and a tau profile rougher than monitor.tau_roughness_warn, or one
+/// whose spread away from its tau mean grew by monitor.tau_spread_growth_warn, is reported once.
 class RunRecorder {
  public:
   /// A declared invariant's change is relative, |X - X0| / |X0|, when |X0| exceeds this, and
@@ -40,7 +41,8 @@ class RunRecorder {
   /// The time of the last row on disk (NaN before any).
   double csv_written_to() const { return t_written_; }
 
-  /// The step observer: false stops the integration.
+  /// The step observer: false stops the integration. steps(), t_reached() and u_last() are
+  /// those of the last recorded step.
   bool observe(long n, double t, const Vector& y);
 
   /// Where the run stands: "running", or "blow-up" with a message.

@@ -3,7 +3,10 @@
 // (relative change), and names it must refuse.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <string>
 
 #include "fixtures/fixture_model.hpp"
@@ -125,4 +128,33 @@ TEST_CASE("recorder: invariant names that are no column names, or whose columns 
   Setup missing(std::vector<ModelInvariant>{{"P", "", nullptr}});
   CHECK_THROWS_WITH_AS(tsi::app::RunRecorder(*missing.model, *missing.direct, exact(0.0), config(1.0, 1.0)),
                        doctest::Contains("without a value function"), tsi::Error);
+}
+
+TEST_CASE("recorder: invariants and monitors run every output.every steps, a finiteness check at every step") {
+  // A declared invariant that counts its evaluations: one at the start, then one per recorded step.
+  auto calls = std::make_shared<long>(0);
+  Setup s({{"c", "counted", [calls](const Vector& u) { return ++*calls, u(0).real(); }}});
+  Json cfg = config(0.1, 2.0);  // 20 steps
+  cfg["output"]["every"] = 7;
+  tsi::app::RunRecorder recorder(*s.model, *s.direct, exact(0.0), cfg);
+  const long at_start = *calls;
+  const auto time = [](long n) { return 0.1 * static_cast<double>(n); };
+  for (long n = 0; n <= 20; ++n) REQUIRE(recorder.observe(n, time(n), exact(time(n))));
+  CHECK(*calls - at_start == 4);  // steps 0, 7, 14 and the last, 20
+  CHECK(recorder.steps() == 20);
+  // The rows are those steps; the maximum of err_H is over them.
+  const std::string csv = recorder.csv();
+  CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 4);
+
+  // A non-finite state between two recorded steps stops the run there, naming both steps.
+  tsi::app::RunRecorder watched(*s.model, *s.direct, exact(0.0), cfg);
+  for (long n = 0; n <= 8; ++n) REQUIRE(watched.observe(n, time(n), exact(time(n))));
+  Vector bad = exact(time(9));
+  bad(1) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_FALSE(watched.observe(9, time(9), bad));
+  CHECK(watched.status() == "blow-up");
+  CHECK(watched.message().find("non-finite at t = 0.9 (step 9)") != std::string::npos);
+  CHECK(watched.message().find("last recorded state is from t = 0.7 (step 7") != std::string::npos);
+  CHECK(watched.steps() == 7);
+  CHECK(watched.u_last() == exact(time(7)));
 }

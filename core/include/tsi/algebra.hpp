@@ -76,6 +76,10 @@ inline void diagonal_linear_combination(const Vector* start, std::span<const Vec
   }
 }
 
+/// True when every entry of x is finite: one pass, no allocation (the check a run makes at
+/// every step, between the steps its observers record).
+inline bool all_finite(const Vector& x) { return x.allFinite(); }
+
 /// Re <x, y> = Re sum conj(x_i) y_i: the inner product of the state as a real vector.
 using tsi::inner;
 
