@@ -39,6 +39,7 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
                 std::string out_dir, const std::vector<std::string>& overrides) {
   Json raw = tsi::app::load_config_file(config_path);
   for (const auto& assignment : overrides) tsi::app::apply_override(raw, assignment);
+  tsi::app::resolve_config_files(raw, config_path);  // model.u0 as a file: relative to the config, as plugins
   if (raw.is_object() && raw.contains("plugins"))
     tsi::app::load_config_plugins(loader, raw["plugins"], config_path);
   const Json config = tsi::app::resolve_run_config(raw, registry);

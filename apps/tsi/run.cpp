@@ -17,6 +17,7 @@
 #include "tsi/phase.hpp"
 #include "tsi/driver.hpp"
 #include "tsi/error.hpp"
+#include "tsi/npy.hpp"
 #include "tsi/output.hpp"
 #include "tsi/version.hpp"
 
@@ -202,6 +203,29 @@ Json state_to_json(const Vector& x, bool complex_state) {
   return out;
 }
 
+Json state_entry(const Vector& x, bool complex_state, const std::vector<std::uint64_t>& shape, const std::string& file) {
+  if (x.size() <= max_inline_state) return state_to_json(x, complex_state);
+  return {{"file", file}, {"dtype", complex_state ? "complex128" : "float64"}, {"shape", shape}};
+}
+
+namespace {
+
+// The shape of the state files: model.u0's file's when the run started from one (an N x 4
+// particle array stays one), else (dim,).
+std::vector<std::uint64_t> state_shape(const Json& config, Index dim) {
+  const std::vector<std::uint64_t> flat = {static_cast<std::uint64_t>(dim)};
+  const Json& u0 = config["model"].value("u0", Json());
+  if (!u0.is_string()) return flat;
+  try {
+    const NpyHeader header = read_npy_header(u0.get<std::string>());
+    return header.count == flat.front() ? header.shape : flat;
+  } catch (const Error&) {  // gone since the run read it: the plain shape
+    return flat;
+  }
+}
+
+}  // namespace
+
 RunOutcome execute_run(const Json& config, const Registry& registry, const ProgressFn& progress,
                        const ReferenceSolution* shared_reference, const std::string& stream_dir) {
   RunOutcome outcome;
@@ -340,7 +364,10 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   result["steps"] = recorder.steps();
   result["t_end"] = t_end;
   result["t_reached"] = recorder.t_reached();
-  result["u_final"] = state_to_json(x, model->is_complex());
+  outcome.complex_state = model->is_complex();
+  outcome.state_shape = state_shape(config, x.size());
+  outcome.u_final = x;
+  result["u_final"] = state_entry(x, outcome.complex_state, outcome.state_shape, u_final_file);
   result["invariants"] = recorder.invariants_json();
   {
     const char* names[3] = {"H", "I", "m"};
@@ -401,7 +428,8 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
     error["reference"]["wall_seconds"] = ref.wall_seconds;
     error["reference"]["estimated_relative_accuracy"] =
         std::isfinite(ref.accuracy) ? Json(ref.accuracy) : Json(nullptr);
-    error["reference"]["u_final"] = state_to_json(ref.x, model->is_complex());
+    outcome.reference_u_final = ref.x;
+    error["reference"]["u_final"] = state_entry(ref.x, outcome.complex_state, outcome.state_shape, reference_u_final_file);
     result["error"] = error;
   }
   return outcome;

@@ -1,6 +1,8 @@
 #pragma once
+#include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "tsi/params.hpp"
 #include "tsi/registry.hpp"
@@ -15,7 +17,21 @@ struct RunOutcome {
   bool ok = true;
   std::string message;  ///< why the run failed (empty when ok)
   std::string io_error;  ///< an output that could not be written (IoError: exit code 3); empty otherwise
+  /// The final state in physical variables (result.json's u_final) and the reference's (its
+  /// error.reference.u_final), written to u_final.npy and reference_u_final.npy; empty when
+  /// the run never started (or its outcome was read back from its files).
+  Vector u_final, reference_u_final;
+  bool complex_state = false;             ///< complex128 files (a complex model), else float64
+  std::vector<std::uint64_t> state_shape;  ///< the files' shape: model.u0's file's, else (dim,)
 };
+
+/// States up to this many values are written inline into result.json (u_final, and the
+/// reference's); larger ones only as {"file": "u_final.npy", "dtype": ..., "shape": [...]}.
+inline constexpr Index max_inline_state = 4096;
+
+/// The file names of the states beside result.json.
+inline constexpr const char* u_final_file = "u_final.npy";
+inline constexpr const char* reference_u_final_file = "reference_u_final.npy";
 
 /// The reference solution at t_end (physical variables) and how good it is.
 struct ReferenceSolution {
@@ -69,5 +85,9 @@ RunOutcome execute_run(const Json& resolved, const Registry& registry, const Pro
 
 /// The physical state as JSON: real numbers, or [re, im] pairs for a complex model.
 Json state_to_json(const Vector& x, bool complex_state);
+
+/// result.json's entry for a state written to `file`: the state itself (state_to_json) up to
+/// max_inline_state values, else {"file": file, "dtype": "float64" | "complex128", "shape": [...]}.
+Json state_entry(const Vector& x, bool complex_state, const std::vector<std::uint64_t>& shape, const std::string& file);
 
 }  // namespace tsi::app

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "tsi/error.hpp"
+#include "tsi/npy.hpp"
 #include "tsi/output.hpp"
 
 namespace tsi::app {
@@ -25,10 +26,42 @@ void prepare_output_dir(const std::string& dir) {
   fs::remove(probe, ec);
 }
 
+namespace {
+
+// Writes one state file of a run, or removes a stale one a previous run left in DIR when this
+// outcome has no such state (a run that never started); an outcome read back from its files
+// (--resume: it has the entry in result.json but no state in memory) leaves the file alone.
+void write_state_file(const std::string& path, const Vector& x, const RunOutcome& outcome, bool has_entry) {
+  if (x.size() > 0) {
+    const std::uint64_t n = static_cast<std::uint64_t>(x.size());
+    std::uint64_t product = 1;
+    for (const std::uint64_t d : outcome.state_shape) product *= d;
+    write_npy(path, x, outcome.complex_state,
+              outcome.state_shape.empty() || product != n ? std::vector<std::uint64_t>{n} : outcome.state_shape);
+  } else if (!has_entry) {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+  }
+}
+
+}  // namespace
+
 void write_run_files(const std::string& dir, const RunOutcome& outcome) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw IoError("cannot create the output directory " + dir + ": " + ec.message());
+  // The states first: result.json may point to them. One that cannot be written (a full disk)
+  // fails the run in the result.json written after it, and is exit code 3 like any output.
+  std::string state_error;
+  try {
+    const Json& result = outcome.result;
+    const bool reference_entry = result.contains("error") && result["error"].contains("reference") &&
+                                 result["error"]["reference"].contains("u_final");
+    write_state_file(dir + "/" + u_final_file, outcome.u_final, outcome, result.contains("u_final"));
+    write_state_file(dir + "/" + reference_u_final_file, outcome.reference_u_final, outcome, reference_entry);
+  } catch (const IoError& e) {
+    state_error = e.what();
+  }
   if (outcome.csv_file.empty()) {
     write_file_atomically(dir + "/invariants.csv", outcome.csv);
   } else {  // streamed while the run went: complete now
@@ -36,8 +69,16 @@ void write_run_files(const std::string& dir, const RunOutcome& outcome) {
   }
   // result.json even when the rows are gone (the directory was removed mid-run): what the
   // run computed is in it.
-  write_file_atomically(dir + "/result.json", outcome.result.dump(2) + "\n");
+  if (state_error.empty()) {
+    write_file_atomically(dir + "/result.json", outcome.result.dump(2) + "\n");
+  } else {
+    Json result = outcome.result;
+    result["status"] = "failed";
+    result["message"] = state_error + (outcome.message.empty() ? "" : "; " + outcome.message);
+    write_file_atomically(dir + "/result.json", result.dump(2) + "\n");
+  }
   if (ec) throw IoError("cannot rename " + outcome.csv_file + " to " + dir + "/invariants.csv: " + ec.message());
+  if (!state_error.empty()) throw IoError(state_error);
 }
 
 }  // namespace tsi::app

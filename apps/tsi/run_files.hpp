@@ -10,8 +10,11 @@ namespace tsi::app {
 /// lost at the end.
 void prepare_output_dir(const std::string& dir);
 
-/// Writes DIR/result.json and DIR/invariants.csv atomically (creating DIR), whether the
-/// run completed or failed part-way.
+/// Writes DIR/result.json, DIR/invariants.csv and the states, DIR/u_final.npy (and
+/// DIR/reference_u_final.npy with a reference), atomically (creating DIR), whether the run
+/// completed or failed part-way. A file that cannot be written is an IoError (exit code 3),
+/// thrown after everything else that could be written is; a state file that could not be
+/// written marks result.json failed, naming it.
 void write_run_files(const std::string& dir, const RunOutcome& outcome);
 
 }  // namespace tsi::app

@@ -81,7 +81,7 @@ int study_command(PluginLoader& loader, Registry& registry, const std::string& s
   Json spec = load_config_file(study_path);
   if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
     load_config_plugins(loader, spec["base"]["plugins"], study_path);
-  const Study study = expand_study(spec, registry, overrides);
+  const Study study = expand_study(spec, registry, overrides, study_path);
   if (out_dir.empty()) out_dir = "out/" + std::filesystem::path(study_path).stem().string();
   prepare_output_dir(out_dir);
   resume = claim_study_dir(out_dir, study, resume, force);

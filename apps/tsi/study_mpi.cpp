@@ -142,7 +142,7 @@ Plan make_plan(PluginLoader& loader, Registry& registry, const StudyCli& cli) {
   Json spec = load_config_file(cli.study_path);
   if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
     load_config_plugins(loader, spec["base"]["plugins"], cli.study_path);
-  p.study = expand_study(spec, registry, cli.overrides);
+  p.study = expand_study(spec, registry, cli.overrides, cli.study_path);
   p.out_dir = cli.out_dir.empty() ? "out/" + std::filesystem::path(cli.study_path).stem().string() : cli.out_dir;
   std::map<std::string, long> index;
   for (size_t i = 0; i < p.study.runs.size(); ++i) {

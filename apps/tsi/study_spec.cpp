@@ -66,7 +66,8 @@ bool is_unknown_parameter(const ConfigError& e) {
 
 }  // namespace
 
-Study expand_study(const Json& spec, const Registry& registry, const std::vector<std::string>& overrides) {
+Study expand_study(const Json& spec, const Registry& registry, const std::vector<std::string>& overrides,
+                   const std::string& study_path) {
   if (!spec.is_object()) throw ConfigError("study", "got " + spec.dump() + ", expected a JSON object");
   for (const auto& [key, value] : spec.items())
     if (key != "kind" && key != "title" && key != "base" && key != "vary" && key != "cases")
@@ -165,6 +166,7 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
         run.assignments[lists[k].first] = value;
         assign_path(raw, lists[k].first, value, "vary." + lists[k].first);
       }
+      resolve_config_files(raw, study_path);  // model.u0 as a file: relative to the study
       for (;;) {
         try {
           run.config = resolve_run_config(raw, registry);

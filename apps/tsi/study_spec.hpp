@@ -31,13 +31,15 @@ struct Study {
   Json not_used = Json::object();
 };
 
-/// Validates and expands a study; every run is resolved before any runs, so a bad path or
-/// value is reported (naming the run and the path) before work starts. `overrides` are
-/// --set assignments applied to the base.
 /// The most runs a study may expand to (counted before expanding): far beyond any real study,
 /// and a bound on the memory the expansion takes.
 inline constexpr long max_study_runs = 100000;
 
-Study expand_study(const Json& spec, const Registry& registry, const std::vector<std::string>& overrides);
+/// Validates and expands a study; every run is resolved before any runs, so a bad path or
+/// value is reported (naming the run and the path) before work starts. `overrides` are
+/// --set assignments applied to the base. Files the runs name (model.u0 as a .npy file) are
+/// relative to the directory of `study_path` (empty: the working directory).
+Study expand_study(const Json& spec, const Registry& registry, const std::vector<std::string>& overrides,
+                   const std::string& study_path = {});
 
 }  // namespace tsi::app

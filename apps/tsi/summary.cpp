@@ -40,7 +40,10 @@ std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
     s += fmt::format("  wall time                 {:.3f} s\n", r["wall_seconds"].get<double>());
   }
   for (const auto& w : r["warnings"]) s += fmt::format("  warning: {}\n", w.get<std::string>());
-  s += fmt::format("  written: {0}/result.json, {0}/invariants.csv\n", out_dir);
+  s += fmt::format("  written: {0}/result.json, {0}/invariants.csv", out_dir);
+  if (outcome.u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, u_final_file);
+  if (outcome.reference_u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, reference_u_final_file);
+  s += "\n";
   return s;
 }
 

@@ -4,11 +4,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <string>
 
 #include "tsi/error.hpp"
+#include "tsi/npy.hpp"
 
 namespace tsi {
 namespace {
@@ -78,6 +81,34 @@ void check_footprint(const Model& model, const Json& reformulation) {
                                   n_tau, dim, needed / 1e9, dim, n_tau, available / 1e9));
 }
 
+// Whether a model's "u0" is the common parameter (an array, or the name of a .npy file); a
+// model that declares a "u0" of its own keeps its own meaning.
+bool u0_may_name_a_file(const ModelEntry& entry) {
+  const auto& params = entry.info.params;
+  const auto it = std::find_if(params.begin(), params.end(), [](const ParamSpec& p) { return p.name == "u0"; });
+  return it != params.end() && it->type == ParamType::Array;
+}
+
+// model.u0 naming a .npy file: made absolute (a relative name is relative to the working
+// directory here; the runner resolves it against the config file's directory first), and its
+// header read and checked now, before anything is computed or written.
+std::string checked_u0_file(const Json& value) {
+  const std::string name = value.get<std::string>();
+  if (name.empty())
+    throw ConfigError("model.u0", "got \"\", expected an array of values or the name of a .npy file");
+  std::error_code ec;
+  std::filesystem::path file = std::filesystem::absolute(name, ec);
+  if (ec) throw ConfigError("model.u0", "cannot resolve the file name \"" + name + "\": " + ec.message());
+  file = file.lexically_normal();
+  try {
+    (void)read_npy_header(file.string());
+  } catch (const Error& e) {
+    throw ConfigError("model.u0", std::string(e.what()) + " (model.u0 as a string names a .npy file of the initial "
+                                                          "value in physical variables)");
+  }
+  return file.string();
+}
+
 }  // namespace
 
 Json resolve_selection(const Json& config, const Registry& registry) {
@@ -96,7 +127,14 @@ Json resolve_selection(const Json& config, const Registry& registry) {
   registry.check_compatible(scheme_entry, reformulation_entry);
 
   Selection selection{model_entry, reformulation_entry, scheme_entry};
-  Json model_params = resolve_params(model_entry.info.params, without_name(model), "model");
+  Json model_given = without_name(model);
+  std::string u0_file;  // model.u0 as the name of a .npy file
+  if (model_given.contains("u0") && model_given["u0"].is_string() && u0_may_name_a_file(model_entry)) {
+    u0_file = checked_u0_file(model_given["u0"]);
+    model_given.erase("u0");
+  }
+  Json model_params = resolve_params(model_entry.info.params, model_given, "model");
+  if (!u0_file.empty()) model_params["u0"] = u0_file;
   Json scheme_params = resolve_params(scheme_entry.info.params, without_name(scheme), "scheme");
   Json reformulation_params =
       resolve_params(reformulation_entry.info.params, without_name(reformulation), "reformulation");
@@ -108,9 +146,65 @@ Json resolve_selection(const Json& config, const Registry& registry) {
           {"scheme", with_name(scheme_entry.info.name, scheme_params)}};
 }
 
+namespace {
+
+// "entry 5", with its index in a shape of several dimensions: "entry 5 (index (1, 1) of shape (2, 4))".
+std::string entry_name(std::uint64_t flat, const std::vector<std::uint64_t>& shape) {
+  if (shape.size() < 2) return fmt::format("entry {}", flat);
+  std::vector<std::uint64_t> index(shape.size());
+  std::uint64_t rest = flat;
+  for (std::size_t k = shape.size(); k-- > 0;) {
+    index[k] = shape[k] ? rest % shape[k] : 0;
+    rest = shape[k] ? rest / shape[k] : 0;
+  }
+  return fmt::format("entry {} (index {} of shape {})", flat, npy_shape_text(index), npy_shape_text(shape));
+}
+
+// model.u0 from a .npy file: as many values as the model's dimension, in any shape; finite;
+// real for a real model (a complex file whose imaginary parts are all zero is taken).
+Vector initial_value_from_file(const Model& model, const std::string& file) {
+  const auto refuse = [&](const std::string& what) {
+    return ConfigError("model.u0", fmt::format("{}: {}", file, what));
+  };
+  NpyHeader header;
+  try {
+    header = read_npy_header(file);
+  } catch (const Error& e) {
+    throw ConfigError("model.u0", e.what());
+  }
+  const std::string kind = model.is_complex() ? "complex" : "real";
+  if (header.count != static_cast<std::uint64_t>(model.dim()))
+    throw refuse(fmt::format("{} values (shape {}), expected {} (the model's dimension: {} values in physical "
+                             "variables, in any shape)",
+                             header.count, npy_shape_text(header.shape), model.dim(), kind));
+  NpyArray array;
+  try {
+    array = read_npy(file);
+  } catch (const Error& e) {
+    throw ConfigError("model.u0", e.what());
+  }
+  const Vector& x = array.values;
+  if (array.header.count != header.count)  // the file was replaced between the two reads
+    throw refuse(fmt::format("{} values, expected {}", array.header.count, model.dim()));
+  for (Index i = 0; i < x.size(); ++i) {
+    const auto flat = static_cast<std::uint64_t>(i);
+    if (!std::isfinite(x(i).real()) || !std::isfinite(x(i).imag()))
+      throw refuse(fmt::format("{} is {}{}; expected finite values", entry_name(flat, array.header.shape),
+                               x(i).real(), array.header.is_complex ? fmt::format("{:+}j", x(i).imag()) : ""));
+    if (!model.is_complex() && x(i).imag() != 0.0)
+      throw refuse(fmt::format("{} is {}{:+}j: a complex value ('{}'), expected real values (this model's state is "
+                               "real; a complex file is taken only when every imaginary part is 0)",
+                               entry_name(flat, array.header.shape), x(i).real(), x(i).imag(), array.header.descr));
+  }
+  return model.from_physical(x);
+}
+
+}  // namespace
+
 Vector initial_value(const Model& model, const Json& model_section) {
   if (!model_section.contains("u0") || model_section["u0"].is_null()) return model.initial_value();
   const Json& u0 = model_section["u0"];
+  if (u0.is_string()) return initial_value_from_file(model, u0.get<std::string>());
   if (!u0.is_array() || static_cast<Index>(u0.size()) != model.dim())
     throw ConfigError("model.u0", fmt::format("got {} entries, expected {} (the model's dimension)",
                                               u0.is_array() ? u0.size() : 1, model.dim()));

@@ -116,7 +116,9 @@ void Registry::add_model(ModelEntry entry) {
   }
   if (!has_param(params, "u0")) {
     params.push_back(
-        array_param("u0", "initial value in physical variables; default: the model's own"));
+        array_param("u0", "initial value in physical variables; default: the model's own")
+            .check([](const Json&) { return true; },
+                   "an array of numbers (complex ones as [re, im]) or the name of a .npy file"));
   }
   impl_->models.add(std::move(entry), impl_->provider);
 }

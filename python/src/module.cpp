@@ -4,6 +4,7 @@
 // Configs and results cross as JSON text; the package turns them into dicts and numpy arrays.
 #include <fmt/format.h>
 #include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -297,12 +298,34 @@ void register_python_model(const std::string& name, py::object cls, const std::s
 
 // ---- Runs and studies -------------------------------------------------------------------------
 
+// A state as numpy (float64 for a real model, complex128 for a complex one, in the shape of
+// its .npy file), None when there is none. States cross as arrays, never through JSON:
+// result.json holds a large one only as the name of its file.
+py::object state_array(const tsi::Vector& x, const tsi::app::RunOutcome& outcome) {
+  if (x.size() == 0) return py::none();
+  std::vector<py::ssize_t> shape;
+  std::uint64_t product = 1;
+  for (const std::uint64_t n : outcome.state_shape) shape.push_back(static_cast<py::ssize_t>(n)), product *= n;
+  if (shape.empty() || product != static_cast<std::uint64_t>(x.size())) shape = {static_cast<py::ssize_t>(x.size())};
+  if (outcome.complex_state) {
+    py::array_t<std::complex<double>> a(shape);
+    std::copy(x.data(), x.data() + x.size(), a.mutable_data());
+    return a;
+  }
+  py::array_t<double> a(shape);
+  double* out = a.mutable_data();
+  for (tsi::Index i = 0; i < x.size(); ++i) out[i] = x(i).real();
+  return a;
+}
+
 py::dict outcome_dict(const tsi::app::RunOutcome& outcome) {
   py::dict d;
   d["result"] = outcome.result.dump();
   d["csv"] = outcome.csv;
   d["ok"] = outcome.ok;
   d["message"] = outcome.message;
+  d["u_final"] = state_array(outcome.u_final, outcome);
+  d["reference_u_final"] = state_array(outcome.reference_u_final, outcome);
   return d;
 }
 

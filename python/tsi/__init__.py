@@ -59,8 +59,9 @@ def _dumps(value):
 
 
 def _state(values):
-    """A state from result.json: numbers, or [re, im] pairs for a complex model."""
-    if values is None:
+    """A state from result.json: numbers, or [re, im] pairs for a complex model (None for a
+    state kept only in its .npy file: {"file": ..., "dtype": ..., "shape": ...})."""
+    if values is None or isinstance(values, dict):
         return None
     a = np.asarray(values, dtype=float)
     return a[..., 0] + 1j * a[..., 1] if a.ndim == 2 else a
@@ -118,12 +119,18 @@ class RunResult:
         self.steps = self.result.get("steps")
         self.t_end = self.result.get("t_end")
         self.t_reached = self.result.get("t_reached")
-        self.u_final = _state(self.result.get("u_final"))
+        # The states come as numpy arrays from the run itself (result.json holds a large one
+        # only as the name of its .npy file); from result.json when given only that.
+        self.u_final = native.get("u_final")
+        if self.u_final is None:
+            self.u_final = _state(self.result.get("u_final"))
         err = self.result.get("error", {})
         self.error = err.get("relative")
         self.error_absolute = err.get("absolute")
         self.reference_info = err.get("reference")
-        self.reference = _state(self.reference_info.get("u_final")) if self.reference_info else None
+        self.reference = native.get("reference_u_final")
+        if self.reference is None and self.reference_info:
+            self.reference = _state(self.reference_info.get("u_final"))
         self.invariants = _columns(native["csv"])
         self.t = self.invariants.get("t")
         self.wall_seconds = self.result.get("wall_seconds")

@@ -103,6 +103,37 @@ class RunTests(unittest.TestCase):
         self.assertEqual(r.u_final.shape, (8,))
         self.assertIsNone(r.error)
 
+    def test_u0_from_a_npy_file_and_u_final_npy(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            u0 = np.array([0.12, -0.1, 0.13, 1 / 9])
+            np.save(os.path.join(tmp, "u0.npy"), u0.reshape(2, 2))
+            from_json = tsi.run(with_(HH, model={"u0": u0.tolist()}))
+            from_file = tsi.run(with_(HH, model={"u0": os.path.join(tmp, "u0.npy")}), out=os.path.join(tmp, "out"))
+            self.assertEqual(from_file.config["model"]["u0"], os.path.join(tmp, "u0.npy"))
+            # The same run; the state keeps u0's shape, as u_final.npy does.
+            self.assertEqual(from_file.u_final.shape, (2, 2))
+            np.testing.assert_array_equal(from_file.u_final.ravel(), from_json.u_final)
+            np.testing.assert_array_equal(from_file.reference.ravel(), from_json.reference)
+            self.assertEqual(from_file.error, from_json.error)
+            np.testing.assert_array_equal(np.load(os.path.join(tmp, "out", "u_final.npy")), from_file.u_final)
+            np.testing.assert_array_equal(np.load(os.path.join(tmp, "out", "reference_u_final.npy")),
+                                          from_file.reference)
+            with self.assertRaises(tsi.ConfigError) as e:
+                tsi.run(with_(HH, model={"u0": os.path.join(tmp, "missing.npy")}))
+            self.assertEqual(e.exception.field, "model.u0")
+
+    def test_a_large_state_arrives_as_an_array(self):
+        # 8192 complex values: result.json names u_final.npy instead of holding them.
+        r = tsi.run({"model": {"name": "nls", "eps": 0.1, "n_x": 8192}, "reformulation": {"name": "direct"},
+                     "scheme": {"name": "strang"}, "time": {"h": 0.125, "t_end": 0.25},
+                     "reference": {"scheme": "strang", "reformulation": "direct", "h": 0.0625}})
+        self.assertEqual(r.result["u_final"], {"file": "u_final.npy", "dtype": "complex128", "shape": [8192]})
+        self.assertEqual(r.u_final.dtype, np.complex128)
+        self.assertEqual(r.u_final.shape, (8192,))
+        self.assertEqual(r.reference.shape, (8192,))
+        own = np.linalg.norm(r.u_final - r.reference) / np.linalg.norm(r.reference)
+        self.assertAlmostEqual(r.error / own, 1.0, delta=1e-12)
+
     def test_numpy_values_in_a_config_are_accepted(self):
         r = tsi.run(with_(HH, model={"eps": np.float64(0.01)}, time={"h": np.float32(0.25)}))
         self.assertEqual(r.steps, 4)

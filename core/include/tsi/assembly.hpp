@@ -43,7 +43,10 @@ TSI_API Assembly assemble(const Json& resolved, const Registry& registry);
 TSI_API Assembly assemble_config(const Json& config, const Registry& registry);
 
 /// The initial value a model section asks for, in model variables: its "u0" (physical
-/// variables: numbers, or [re, im] pairs for a complex model) or the model's default.
+/// variables: numbers, or [re, im] pairs for a complex model; or the name of a .npy file of
+/// float64 or complex128 values, as many as the model's dimension in any shape, finite, and
+/// real for a real model) or the model's default. resolve_selection makes a file name absolute
+/// (relative to the working directory) and checks its header; the values are read here.
 TSI_API Vector initial_value(const Model& model, const Json& model_section);
 
 }  // namespace tsi

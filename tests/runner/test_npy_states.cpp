@@ -1,0 +1,278 @@
+// States as .npy files end to end: model.u0 naming a file (relative to the config or study),
+// the same run as the same u0 in JSON to the bit; u_final.npy (and reference_u_final.npy)
+// beside every result.json, equal to its u_final, in u0's shape; large states only as files;
+// bad files refused as bad input naming model.u0 and the file; a file that cannot be written
+// is exit code 3.
+#include <doctest/doctest.h>
+
+#include <string>
+#include <vector>
+
+#include "run_command.hpp"
+#include "tsi/npy.hpp"
+
+namespace t = tsi::test;
+
+namespace {
+
+// Runs a NumPy script with Debian's interpreter (scripts/install-deps.sh installs python3-numpy).
+void python(const std::string& script, const std::string& cwd) {
+  const t::CommandResult r = t::run_command("/usr/bin/python3", {"-c", "import numpy as np, json, sys\n" + script}, {}, cwd);
+  INFO("the test needs /usr/bin/python3 with numpy (python3-numpy, scripts/install-deps.sh)");
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+}
+
+// result.json's u_final (numbers, or [re, im] pairs) equals the values of `file`, exactly.
+void check_state_file(const t::fs::path& file, const t::Json& state, bool complex_state) {
+  INFO(file.string());
+  const tsi::NpyArray a = tsi::read_npy(file.string());
+  CHECK(a.header.descr == (complex_state ? "<c16" : "<f8"));
+  REQUIRE(a.values.size() == static_cast<tsi::Index>(state.size()));
+  for (std::size_t i = 0; i < state.size(); ++i) {
+    const tsi::Complex want = complex_state ? tsi::Complex(state[i][0].get<double>(), state[i][1].get<double>())
+                                            : tsi::Complex(state[i].get<double>(), 0.0);
+    CHECK(a.values(static_cast<tsi::Index>(i)) == want);
+  }
+}
+
+t::Json hh_config() {
+  return {{"model", {{"name", "henon-heiles"}, {"eps", 0.1}}},
+          {"reformulation", {{"name", "two-scale"}, {"n_tau", 16}}},
+          {"scheme", {{"name", "se1"}}},
+          {"time", {{"h", 0.25}, {"t_end", 1.0}}},
+          {"reference", t::Json::object()}};
+}
+
+t::Json nls_config(int n_x) {
+  return {{"model", {{"name", "nls"}, {"eps", 0.1}, {"n_x", n_x}}},
+          {"reformulation", {{"name", "two-scale"}, {"n_tau", 16}}},
+          {"scheme", {{"name", "se1"}}},
+          {"time", {{"h", 0.25}, {"t_end", 0.5}}},
+          {"reference", t::Json::object()}};
+}
+
+// NLS on 8192 points, two Strang steps on the direct problem against Strang at half the step:
+// a state of 8192 complex values, above what result.json holds inline, in a fraction of a second.
+t::Json large_nls_config() {
+  return {{"model", {{"name", "nls"}, {"eps", 0.1}, {"n_x", 8192}}},
+          {"reformulation", {{"name", "direct"}}},
+          {"scheme", {{"name", "strang"}}},
+          {"time", {{"h", 0.125}, {"t_end", 0.25}}},
+          {"reference", {{"scheme", "strang"}, {"reformulation", "direct"}, {"h", 0.0625}}}};
+}
+
+}  // namespace
+
+TEST_SUITE("tsi_runner_tests") {
+
+TEST_CASE("npy states: u0 from a .npy file runs bit for bit as the same u0 in JSON; u_final.npy is result.json's u_final") {
+  for (const bool complex_model : {false, true}) {
+    CAPTURE(complex_model);
+    t::TempDir dir("tsi-npy-run");
+    t::fs::create_directory(dir.path() / "configs");
+    // Values a JSON number and a float64 hold alike (Python's repr round-trips).
+    python(complex_model ? R"py(
+x = np.linspace(0, 2 * np.pi, 8, endpoint=False)
+u = (1 + 0.3 * np.cos(x)) * np.exp(1j * x) / 3
+np.save('configs/u0.npy', u)
+json.dump([[float(v.real), float(v.imag)] for v in u], open('u0.json', 'w'))
+)py"
+                         : R"py(
+u = np.array([0.12, -0.1, 0.13, 1 / 9])
+np.save('configs/u0.npy', u)
+json.dump([float(v) for v in u], open('u0.json', 'w'))
+)py",
+           dir.path());
+    t::Json with_file = complex_model ? nls_config(8) : hh_config(), with_json = with_file;
+    with_file["model"]["u0"] = "u0.npy";  // relative to the config's directory, not to where tsi runs
+    with_json["model"]["u0"] = t::read_json(dir.path() / "u0.json");
+    const std::string config_file = t::write_config(dir, with_file, "configs/file.json");
+    const std::string config_json = t::write_config(dir, with_json, "configs/json.json");
+    const t::CommandResult a = t::run_tsi({"run", config_file, "--out", dir / "a"}, {}, "/");
+    const t::CommandResult b = t::run_tsi({"run", config_json, "--out", dir / "b"}, {}, "/");
+    INFO(a.describe());
+    INFO(b.describe());
+    REQUIRE(a.exit_code == 0);
+    REQUIRE(b.exit_code == 0);
+    CHECK(t::contains(a.out, dir / "a/u_final.npy"));
+    CHECK(t::contains(a.out, dir / "a/reference_u_final.npy"));
+    const t::Json ra = t::read_json(dir.path() / "a/result.json"), rb = t::read_json(dir.path() / "b/result.json");
+    // The resolved config records the file's absolute name.
+    CHECK(ra["config"]["model"]["u0"] == (dir.path() / "configs/u0.npy").string());
+    CHECK(ra["u_final"] == rb["u_final"]);
+    CHECK(ra["error"]["relative"] == rb["error"]["relative"]);
+    CHECK(ra["error"]["reference"]["u_final"] == rb["error"]["reference"]["u_final"]);
+    CHECK(ra["invariants"] == rb["invariants"]);
+    CHECK(t::read_text(dir.path() / "a/invariants.csv") == t::read_text(dir.path() / "b/invariants.csv"));
+    for (const char* file : {"u_final.npy", "reference_u_final.npy"})
+      CHECK(t::read_text(dir.path() / "a" / file) == t::read_text(dir.path() / "b" / file));
+    REQUIRE(ra["u_final"].is_array());
+    check_state_file(dir.path() / "a/u_final.npy", ra["u_final"], complex_model);
+    check_state_file(dir.path() / "a/reference_u_final.npy", ra["error"]["reference"]["u_final"], complex_model);
+    // NumPy reads them as the same state.
+    python(R"py(
+r = json.load(open('a/result.json'))
+def state(v):
+    a = np.array(v, dtype=float)
+    return a[:, 0] + 1j * a[:, 1] if a.ndim == 2 else a
+for name, want in [('a/u_final.npy', r['u_final']), ('a/reference_u_final.npy', r['error']['reference']['u_final'])]:
+    got = np.load(name)
+    assert got.shape == (len(want),) and np.array_equal(got, state(want)), name
+    assert got.dtype == (np.complex128 if isinstance(want[0], list) else np.float64), got.dtype
+)py",
+           dir.path());
+  }
+}
+
+TEST_CASE("npy states: a state above 4096 values is only a file in result.json, in the shape of u0's file") {
+  t::TempDir dir("tsi-npy-run");
+  python(R"py(
+x = np.linspace(0, 2 * np.pi, 8192, endpoint=False)
+np.save('u0.npy', ((1 + 0.3 * np.cos(x)) * np.exp(1j * x) / 3).reshape(64, 128))
+np.save('hh.npy', np.array([[0.12, 0.12], [0.12, 0.12]]))
+)py",
+         dir.path());
+  t::Json config = large_nls_config();
+  config["model"]["u0"] = "u0.npy";
+  const t::CommandResult r = t::run_tsi({"run", t::write_config(dir, config), "--out", dir / "out"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  const t::Json result = t::read_json(dir.path() / "out/result.json");
+  const t::Json entry = {{"file", "u_final.npy"}, {"dtype", "complex128"}, {"shape", {64, 128}}};
+  CHECK(result["u_final"] == entry);
+  t::Json reference_entry = entry;
+  reference_entry["file"] = "reference_u_final.npy";
+  CHECK(result["error"]["reference"]["u_final"] == reference_entry);
+  CHECK(t::read_text(dir.path() / "out/result.json").size() < 20000);  // no state in it
+  const tsi::NpyArray u = tsi::read_npy(dir / "out/u_final.npy"), ref = tsi::read_npy(dir / "out/reference_u_final.npy");
+  CHECK(u.header.shape == std::vector<std::uint64_t>{64, 128});
+  CHECK(ref.header.shape == std::vector<std::uint64_t>{64, 128});
+  CHECK(u.values.allFinite());
+  // The error result.json reports is that of the two files (discrete L2 on the grid: a ratio of norms).
+  const double error = (u.values - ref.values).norm() / ref.values.norm();
+  CHECK(error == doctest::Approx(result["error"]["relative"].get<double>()).epsilon(1e-12));
+
+  // Without a file, the states are 1-D; a small state stays inline and keeps u0's shape in its file.
+  config["model"].erase("u0");
+  const t::CommandResult flat = t::run_tsi({"run", t::write_config(dir, config), "--out", dir / "flat"});
+  REQUIRE(flat.exit_code == 0);
+  CHECK(t::read_json(dir.path() / "flat/result.json")["u_final"]["shape"] == t::Json::array({8192}));
+  t::Json hh = hh_config();
+  hh["model"]["u0"] = "hh.npy";
+  const t::CommandResult small = t::run_tsi({"run", t::write_config(dir, hh), "--out", dir / "hh"});
+  REQUIRE(small.exit_code == 0);
+  const t::Json hh_result = t::read_json(dir.path() / "hh/result.json");
+  CHECK(hh_result["u_final"].size() == 4);
+  CHECK(tsi::read_npy_header(dir / "hh/u_final.npy").shape == std::vector<std::uint64_t>{2, 2});
+  python("assert np.load('hh/u_final.npy').shape == (2, 2)\nassert np.load('out/u_final.npy').shape == (64, 128)",
+         dir.path());
+}
+
+TEST_CASE("npy states: a run that stops part-way writes u_final.npy of its last state; a stale reference file goes") {
+  t::TempDir dir("tsi-npy-run");
+  t::Json config = hh_config();
+  const t::CommandResult first = t::run_tsi({"run", t::write_config(dir, config), "--out", dir / "out"});
+  REQUIRE(first.exit_code == 0);
+  REQUIRE(t::fs::exists(dir.path() / "out/reference_u_final.npy"));
+  config.erase("reference");
+  config["monitor"] = {{"max_err_H", 1e-12}};  // a blow-up at the first step
+  const t::CommandResult r = t::run_tsi({"run", t::write_config(dir, config), "--out", dir / "out"});
+  INFO(r.describe());
+  CHECK(r.exit_code == 1);
+  const t::Json result = t::read_json(dir.path() / "out/result.json");
+  CHECK(result["status"] == "blow-up");
+  CHECK(result["steps"] == 1);
+  check_state_file(dir.path() / "out/u_final.npy", result["u_final"], false);
+  CHECK_FALSE(t::fs::exists(dir.path() / "out/reference_u_final.npy"));  // from the run before
+}
+
+TEST_CASE("npy states: a bad u0 file is bad input naming model.u0 and the file, before anything is written") {
+  t::TempDir dir("tsi-npy-run");
+  python(R"py(
+np.save('five.npy', np.full(5, 0.1))
+np.save('complex.npy', np.array([0.1, 0.1, 0.1, 0.1 + 1e-3j]))
+np.save('nan.npy', np.array([[0.1, np.nan], [0.1, 0.1]]))
+np.save('big_endian.npy', np.full(4, 0.1).astype('>f8'))
+np.save('ints.npy', np.ones(4, dtype=np.int64))
+np.save('real_zero_imag.npy', np.full(4, 0.12 + 0j))
+b = open('five.npy', 'rb').read()
+open('truncated.npy', 'wb').write(b[:-8])
+open('lying.npy', 'wb').write(b.replace(b"(5,)", b"(9,)"))
+)py",
+         dir.path());
+  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+      {"five.npy", {"5 values (shape (5,)), expected 4 (the model's dimension"}},
+      {"complex.npy", {"entry 3 is 0.1+0.001j", "expected real values"}},
+      {"nan.npy", {"entry 1 (index (0, 1) of shape (2, 2)) is nan", "expected finite values"}},
+      {"big_endian.npy", {"'>f8' is big-endian"}},
+      {"ints.npy", {"dtype '<i8' is not supported"}},
+      {"truncated.npy", {"truncated"}},
+      {"lying.npy", {"truncated, or not what its header says", "(9,)"}},
+      {"missing.npy", {"cannot open: No such file or directory"}},
+      {"sub/../missing.npy", {"cannot open"}}};
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const auto& [file, words] = cases[k];
+    CAPTURE(file);
+    t::Json config = hh_config();
+    config["model"]["u0"] = file;
+    const std::string out = dir / ("out-" + std::to_string(k));
+    const t::CommandResult r = t::run_tsi({"run", t::write_config(dir, config), "--out", out});
+    INFO(r.describe());
+    CHECK(r.exit_code == 2);
+    const std::string path = t::fs::path(dir / file).lexically_normal().string();
+    CHECK(t::contains(r.err, "tsi: error: model.u0: " + path));
+    for (const auto& w : words) CHECK(t::contains(r.err, w));
+    CHECK_FALSE(t::fs::exists(t::fs::path(out) / "result.json"));
+  }
+  // A complex file of zero imaginary parts is a real u0.
+  t::Json config = hh_config();
+  config["model"]["u0"] = "real_zero_imag.npy";
+  const t::CommandResult ok = t::run_tsi({"run", t::write_config(dir, config), "--out", dir / "ok"});
+  INFO(ok.describe());
+  CHECK(ok.exit_code == 0);
+}
+
+TEST_CASE("npy states: a study's u0 files are relative to the study, and every run writes u_final.npy") {
+  t::TempDir dir("tsi-npy-run");
+  t::fs::create_directory(dir.path() / "study");
+  python("np.save('study/a.npy', np.full(4, 0.12))\nnp.save('study/b.npy', np.full(4, 0.1))", dir.path());
+  t::Json base = hh_config();
+  base.erase("reference");
+  base["model"]["u0"] = "a.npy";
+  const t::Json study = {{"kind", "conservation"},
+                         {"base", base},
+                         {"cases", {{{"label", "a"}}, {{"label", "b"}, {"set", {{"model.u0", "b.npy"}}}}}}};
+  const std::string file = t::write_config(dir, study, "study/study.json");
+  const t::CommandResult r = t::run_tsi({"study", file, "--out", dir / "out", "--jobs", "1", "--no-plots"}, {}, "/");
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  for (const auto& [id, name] : {std::pair{"r0001", "a.npy"}, std::pair{"r0002", "b.npy"}}) {
+    const t::fs::path run = dir.path() / "out/runs" / id;
+    const t::Json result = t::read_json(run / "result.json");
+    CHECK(result["config"]["model"]["u0"] == (dir.path() / "study" / name).string());
+    check_state_file(run / "u_final.npy", result["u_final"], false);
+  }
+  CHECK(t::read_json(dir.path() / "out/runs/r0001/result.json")["u_final"] !=
+        t::read_json(dir.path() / "out/runs/r0002/result.json")["u_final"]);
+}
+
+TEST_CASE("npy states: a u_final.npy that cannot be written (a full disk) is exit code 3, and result.json says so") {
+  t::TempDir dir("tsi-npy-run");
+  t::Json config = large_nls_config();
+  config.erase("reference");
+  t::CommandEnv env;
+  env.file_size_limit = 100000;  // u_final.npy has 131,200 bytes; result.json and invariants.csv fit
+  const t::CommandResult r = t::run_tsi({"run", t::write_config(dir, config), "--out", dir / "out"}, env);
+  INFO(r.describe());
+  CHECK(r.exit_code == 3);
+  CHECK(t::contains(r.err, "tsi: error: cannot write " + dir / "out/u_final.npy" + ": File too large"));
+  const t::Json result = t::read_json(dir.path() / "out/result.json");
+  CHECK(result["status"] == "failed");
+  CHECK(t::contains(result["message"].get<std::string>(), "u_final.npy: File too large"));
+  CHECK_FALSE(t::fs::exists(dir.path() / "out/u_final.npy"));
+  for (const auto& entry : t::fs::directory_iterator(dir.path() / "out"))
+    CHECK_FALSE(t::contains(entry.path().filename().string(), ".tmp."));
+}
+
+}  // TEST_SUITE
