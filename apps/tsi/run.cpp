@@ -244,8 +244,12 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   std::shared_ptr<const Model> model = assembly.model;
   const Vector u0 = assembly.u0;
   {  // an initial value whose invariants overflow (entries of 1e300) would only "blow up" at t = 0
-    const double H0 = model->energy(u0), I0 = model->oscillatory_energy(u0), m0 = model->mass(u0);
-    if (!u0.allFinite() || !std::isfinite(H0) || !std::isfinite(I0) || !std::isfinite(m0))
+    if (!u0.allFinite())
+      throw ConfigError("model.u0", "the initial value has non-finite entries; expected finite numbers");
+    const bool hamiltonian = model->has_hamiltonian_structure();
+    const double H0 = hamiltonian ? model->energy(u0) : 0.0, I0 = hamiltonian ? model->oscillatory_energy(u0) : 0.0,
+                 m0 = hamiltonian ? model->mass(u0) : 0.0;
+    if (!std::isfinite(H0) || !std::isfinite(I0) || !std::isfinite(m0))
       throw ConfigError("model.u0", fmt::format("H = {}, I = {}, m = {} at the initial value; expected an initial "
                                                 "value whose invariants are finite numbers",
                                                 H0, I0, m0));
@@ -371,7 +375,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   result["invariants"] = recorder.invariants_json();
   {
     const char* names[3] = {"H", "I", "m"};
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; model->has_hamiltonian_structure() && k < 3; ++k) {
       const double d = recorder.drift(k);
       result["invariants"][names[k]]["drift"] = std::isnan(d) ? Json() : Json(d);
     }

@@ -44,15 +44,19 @@ RunRecorder::RunRecorder(const Model& model, Reformulation& reformulation, const
                          const Json& config, const std::string& csv_path)
     : model_(model),
       reformulation_(reformulation),
+      hamiltonian_(model.has_hamiltonian_structure()),
       every_(config["output"]["every"]),
       n_steps_(step_count(config)),
       max_err_H_(config["monitor"]["max_err_H"]),
       roughness_warn_(config["monitor"]["tau_roughness_warn"]),
       spread_growth_warn_(config["monitor"]["tau_spread_growth_warn"]),
       u_(u0),
-      csv_("t,H,I,m,err_H,err_I,err_m,tau_roughness,tau_spread\n") {
-  const double initial[3] = {model.energy(u0), model.oscillatory_energy(u0), model.mass(u0)};
-  for (int k = 0; k < 3; ++k) tracks_[k].initial = tracks_[k].final = initial[k];
+      csv_(hamiltonian_ ? "t,H,I,m,err_H,err_I,err_m,tau_roughness,tau_spread\n" : "t,tau_roughness,tau_spread\n") {
+  // H, I and m exist only for a model that declares the Hamiltonian structure.
+  if (hamiltonian_) {
+    const double initial[3] = {model.energy(u0), model.oscillatory_energy(u0), model.mass(u0)};
+    for (int k = 0; k < 3; ++k) tracks_[k].initial = tracks_[k].final = initial[k];
+  }
   std::set<std::string> taken = {"t", "H", "I", "m", "err_H", "err_I", "err_m", "tau_roughness", "tau_spread"};
   for (auto& invariant : model.invariants()) {
     if (!invariant.value)
@@ -154,14 +158,15 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
     return false;
   }
   const Vector u = reformulation_.read_back(y, t);
-  const double values[3] = {model_.energy(u), model_.oscillatory_energy(u), model_.mass(u)};
+  double values[3] = {0.0, 0.0, 0.0};
+  if (hamiltonian_) values[0] = model_.energy(u), values[1] = model_.oscillatory_energy(u), values[2] = model_.mass(u);
   if (!u.allFinite() || !std::isfinite(values[0] + values[1] + values[2])) {
     status_ = "blow-up";
     message_ = fmt::format("the solution became non-finite at t = {:.6g} (step {})", t, n);
     return false;
   }
-  double errors[3];
-  for (int k = 0; k < 3; ++k) {
+  double errors[3] = {0.0, 0.0, 0.0};
+  for (int k = 0; hamiltonian_ && k < 3; ++k) {
     errors[k] = relative_change(values[k], tracks_[k].initial);
     tracks_[k].final = values[k];
     tracks_[k].max_rel_error = std::max(tracks_[k].max_rel_error, errors[k]);
@@ -204,12 +209,14 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
   }
   const bool blow_up = errors[0] > max_err_H_;
   if (n % every_ == 0 || n == n_steps_ || blow_up) {
-    std::string row = fmt::format("{:.17g},{:.17g},{:.17g},{:.17g},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}", t, values[0],
-                                  values[1], values[2], errors[0], errors[1], errors[2], roughness, spread);
+    std::string row = hamiltonian_ ? fmt::format("{:.17g},{:.17g},{:.17g},{:.17g},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}", t,
+                                                 values[0], values[1], values[2], errors[0], errors[1], errors[2],
+                                                 roughness, spread)
+                                   : fmt::format("{:.17g},{:.6e},{:.6e}", t, roughness, spread);
     for (const auto& d : declared_) row += fmt::format(",{:.17g},{:.6e}", d.final, d.change);
     write_row(row + "\n", t);
     if (t >= drift_from_)
-      for (int k = 0; k < 3; ++k) {
+      for (int k = 0; hamiltonian_ && k < 3; ++k) {
         // The printed value, as a drift fitted to the file would see it.
         const double printed = std::stod(fmt::format("{:.6e}", errors[k]));
         double* s = drift_sums_[k];
@@ -226,9 +233,9 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
 }
 
 Json RunRecorder::invariants_json() const {
-  Json out;
+  Json out = Json::object();
   const char* names[3] = {"H", "I", "m"};
-  for (int k = 0; k < 3; ++k)
+  for (int k = 0; hamiltonian_ && k < 3; ++k)
     out[names[k]] = {{"initial", tracks_[k].initial},
                      {"final", tracks_[k].final},
                      {"max_rel_error", tracks_[k].max_rel_error}};

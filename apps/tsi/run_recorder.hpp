@@ -60,7 +60,8 @@ class RunRecorder {
   /// The rows of invariants.csv (empty when they were streamed to csv_path).
   const std::string& csv() const { return csv_; }
   /// Least-squares slope of the relative change of H, I, m (k = 0, 1, 2) against t over the
-  /// rows with t >= drift_from (NaN with fewer than two): the drift a study reports.
+  /// rows with t >= drift_from (NaN with fewer than two, and without a Hamiltonian structure):
+  /// the drift a study reports.
   double drift(int k) const;
 
  private:
@@ -77,6 +78,7 @@ class RunRecorder {
   };
   const Model& model_;
   Reformulation& reformulation_;
+  bool hamiltonian_;  // H, I, m and their columns only where the model declares the structure
   long every_, n_steps_;
   double max_err_H_, roughness_warn_, spread_growth_warn_;
   Track tracks_[3];  // H, I, m

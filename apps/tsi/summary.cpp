@@ -22,8 +22,9 @@ std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
                        r["error"]["relative"].get<double>(), r["error"]["reference"]["scheme"].get<std::string>(),
                        r["error"]["reference"]["reformulation"].get<std::string>(),
                        r["error"]["reference"]["tol"].get<double>());
-    for (const char* name : {"H", "I", "m"})
-      s += fmt::format("  max rel. change of {}     {:.3e}   ({:.10g} -> {:.10g})\n", name,
+    for (const char* name : {"H", "I", "m"})  // absent for a model without Hamiltonian structure
+      if (r["invariants"].contains(name))
+        s += fmt::format("  max rel. change of {}     {:.3e}   ({:.10g} -> {:.10g})\n", name,
                        r["invariants"][name]["max_rel_error"].get<double>(),
                        r["invariants"][name]["initial"].get<double>(), r["invariants"][name]["final"].get<double>());
     for (const auto& [name, inv] : r["invariants"].items())  // the model's own (those with a "change")

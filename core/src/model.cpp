@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "tsi/error.hpp"
 
@@ -81,6 +82,23 @@ double Model::remainder_energy(const Vector& u) const {
   apply_J(i_omega_u, r);
   return -0.5 * inner(r, u);
 }
+
+namespace {
+[[noreturn]] void no_hamiltonian(const char* what) {
+  throw Error(std::string("this model declares no Hamiltonian structure (has_hamiltonian_structure() is false): it "
+                          "has no ") + what);
+}
+}  // namespace
+
+void Model::apply_A(const Vector& u, Vector& out) const {
+  Vector mu(u.size());
+  apply_M(u, mu);
+  apply_J(mu, out);
+}
+
+void Model::apply_M(const Vector&, Vector&) const { no_hamiltonian("M"); }
+void Model::apply_J(const Vector&, Vector&) const { no_hamiltonian("J"); }
+double Model::H1(const Vector&) const { no_hamiltonian("H1"); }
 
 void Model::nonlinear_flow(double /*t*/, Vector& /*u*/) const {
   throw Error("this model has no exact nonlinear flow (has_exact_nonlinear_flow() is false)");

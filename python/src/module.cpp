@@ -123,6 +123,9 @@ class PythonModel final : public tsi::Model {
     complex_ = py::hasattr(self, "is_complex") && self.attr("is_complex").cast<bool>();
     has_filtered_ = py::hasattr(self, "filtered_field");
     has_derivative_ = py::hasattr(self, "nonlinear_field_derivative");
+    // `hamiltonian = False`: the general class, with apply_A instead of apply_M, apply_J and H1.
+    hamiltonian_ = !py::hasattr(self, "hamiltonian") || self.attr("hamiltonian").cast<bool>();
+    has_apply_A_ = py::hasattr(self, "apply_A");
     max_frequency_ = py::hasattr(self, "max_linear_frequency") ? self.attr("max_linear_frequency").cast<double>() : 1.0;
   }
   ~PythonModel() override {
@@ -134,6 +137,7 @@ class PythonModel final : public tsi::Model {
 
   tsi::Index dim() const override { return dim_; }
   bool is_complex() const override { return complex_; }
+  bool has_hamiltonian_structure() const override { return hamiltonian_; }
   double max_linear_frequency() const override { return max_frequency_; }
 
   void linear_flow(const tsi::RealVector& taus, tsi::MatrixRef states) const override {
@@ -195,6 +199,10 @@ class PythonModel final : public tsi::Model {
     });
   }
 
+  void apply_A(const tsi::Vector& u, tsi::Vector& out) const override {
+    if (!has_apply_A_) return Model::apply_A(u, out);
+    out = call_python(name_, "apply_A", [&] { return vector(self().attr("apply_A")(one(u)), "apply_A"); });
+  }
   void apply_M(const tsi::Vector& u, tsi::Vector& out) const override {
     out = call_python(name_, "apply_M", [&] { return vector(self().attr("apply_M")(one(u)), "apply_M"); });
   }
@@ -242,7 +250,7 @@ class PythonModel final : public tsi::Model {
   std::string name_;
   PyObject* self_;
   tsi::Index dim_ = 0;
-  bool complex_ = false, has_filtered_ = false, has_derivative_ = false;
+  bool complex_ = false, has_filtered_ = false, has_derivative_ = false, hamiltonian_ = true, has_apply_A_ = false;
   double max_frequency_ = 1.0;
 };
 

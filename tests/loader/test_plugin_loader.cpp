@@ -142,7 +142,8 @@ TEST_CASE("loader: a directory scan collects failures without throwing") {
   // Sorted: duplicate loads before good into the empty registry, so good clashes with it;
   // shipped_duplicate's "henon-heiles" is free here (no shipped plugins in this registry).
   const std::vector<std::pair<const char*, bool>> expected = {
-      {"broken_flow", true}, {"broken_fused", true},      {"duplicate", true},        {"good", false},
+      {"broken_flow", true}, {"broken_fused", true},      {"duplicate", true},        {"general", true},
+      {"good", false},
       {"no_entry", false},   {"shipped_duplicate", true}, {"stiff", true},           {"throws", false},
       {"wrong_abi", false},  {"wrong_layout", false},     {"wrong_major", false},     {"wrong_sanitizer", false}};
   REQUIRE(reports.size() == expected.size());
@@ -152,8 +153,8 @@ TEST_CASE("loader: a directory scan collects failures without throwing") {
     CHECK(reports[i].ok == expected[i].second);
     CHECK(reports[i].error.empty() == expected[i].second);
   }
-  CHECK(reports[3].error.find("already registered") != std::string::npos);
-  CHECK(reports[9].error.find("tsi::ModelEntry") != std::string::npos);
+  CHECK(reports[4].error.find("already registered") != std::string::npos);
+  CHECK(reports[10].error.find("tsi::ModelEntry") != std::string::npos);
   CHECK(r.scheme("fixture-duplicate-scheme").info.provider == fixture("duplicate"));
   CHECK(loader.reports().size() == reports.size());
 }

@@ -29,7 +29,10 @@ struct TSI_API ModelInvariant {
   std::function<double(const Vector& u)> value;  ///< of a state in model variables
 };
 
-/// The problem class of the paper (eq. model), with an optional second linear part R:
+/// The general class u' = (1/eps) A u + R u + f(u) (SPEC.md section 7): a model gives the
+/// action of e^{A tau} (2 pi-periodic), an optional remainder R and f. Most models have the
+/// Hamiltonian structure of the paper's class (eq. model), which they declare
+/// (has_hamiltonian_structure, apply_M, apply_J, H1):
 ///     u' = J [ (1/eps) M u + R u + grad H1(u) ],   eps in (0, 1],
 /// J symplectic, M self-adjoint, JM = MJ, and tau -> e^{JM tau} 2*pi-periodic. R (default: none)
 /// is a linear part bounded in eps but possibly large (a spatial operator), handed over so that
@@ -73,12 +76,20 @@ class TSI_API Model {
   /// The default is a central difference; models with a closed form should override it.
   virtual void nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef directions,
                                           MatrixRef out) const;
-  /// M u.
-  virtual void apply_M(const Vector& u, Vector& out) const = 0;
-  /// J u.
-  virtual void apply_J(const Vector& u, Vector& out) const = 0;
-  /// The non-stiff part H1 of the Hamiltonian.
-  virtual double H1(const Vector& u) const = 0;
+  /// True when the model declares the Hamiltonian structure (J, M, H1 with f = J grad H1,
+  /// e^{A tau} = e^{JM tau}): then runs report H, I and m and `tsi check` tests it. A model of
+  /// the general class u' = (1/eps) A u + R u + f(u) with f no Hamiltonian field returns false,
+  /// implements apply_A instead of apply_M and apply_J, and no energy is computed or shown.
+  virtual bool has_hamiltonian_structure() const { return true; }
+  /// A u, the generator of the fast flow e^{A tau} (the direct problem's u' = (1/eps) A u + ...).
+  /// The default is J M u; a model without the Hamiltonian structure must override it.
+  virtual void apply_A(const Vector& u, Vector& out) const;
+  /// M u (Hamiltonian structure; the default throws tsi::Error).
+  virtual void apply_M(const Vector& u, Vector& out) const;
+  /// J u (Hamiltonian structure; the default throws tsi::Error).
+  virtual void apply_J(const Vector& u, Vector& out) const;
+  /// The non-stiff part H1 of the Hamiltonian (Hamiltonian structure; the default throws).
+  virtual double H1(const Vector& u) const;
 
   /// The second linear part R, by the frequencies omega_j of J R: J R multiplies coordinate j
   /// of u by i omega_j. It must commute with JM (tsi check tests it) and, for a real model, be

@@ -39,7 +39,7 @@ Direct::Direct(std::shared_ptr<const Model> model, Variables variables)
       direction_(model_->dim(), 1),
       field_(model_->dim(), 1),
       mu_(model_->dim()),
-      jmu_(model_->dim()),
+      au_(model_->dim()),
       remainder_(model_remainder(*model_)) {
   if (physical_) {
     require_linear_to_physical(*model_);
@@ -55,9 +55,13 @@ void Direct::model_nonlinear(const Vector& u, Vector& out) {
 
 void Direct::model_rhs(const Vector& u, Vector& out) {
   model_nonlinear(u, out);
-  model_->apply_M(u, mu_);
-  model_->apply_J(mu_, jmu_);
-  out += jmu_ / model_->eps();
+  if (model_->has_hamiltonian_structure()) {  // J M u through the run's buffers (apply_A's default allocates)
+    model_->apply_M(u, mu_);
+    model_->apply_J(mu_, au_);
+  } else {
+    model_->apply_A(u, au_);
+  }
+  out += au_ / model_->eps();
   if (remainder_.size()) out += remainder_.cwiseProduct(u);
 }
 

@@ -47,7 +47,7 @@ class Direct final : public Reformulation {
   Index size_;
   Vector none_;
   Matrix state_, direction_, field_;
-  Vector mu_, jmu_;
+  Vector mu_, au_;  // M u and A u
   Vector remainder_;  // i omega per coordinate (empty without a remainder)
 };
 
