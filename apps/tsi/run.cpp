@@ -311,8 +311,8 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
       result["initial_data_order_reached"] = data_order;
       if (rconf.contains("initial_data_order") && data_order < rconf["initial_data_order"].get<int>())
         result["warnings"].push_back(fmt::format(
-            "prepared data reached order {} of the {} asked: the recursion's corrections stopped decreasing "
-            "(eps = {:g} is too large for its asymptotic expansion beyond that order)",
+            "prepared data reached order {} of the {} asked: eps = {:g} is too large for their asymptotic "
+            "expansion beyond that order",
             data_order, rconf["initial_data_order"].get<int>(), model->eps()));
     }
     integrate(*stepper, y, n_steps, [&](long n, double t, const Vector& state) {

@@ -30,9 +30,11 @@ void register_core(Registry& registry) {
            .check([](const Json& v) { return v.get<long>() >= 1 && v.get<long>() <= TwoScale::max_data_order; },
                   "an integer from 1 to 8"),
        string_param("initial_data_method", "auto",
-                    "auto: SPEC.md's closed formulas for orders 1-3, the derivative-free recursion above; "
-                    "recursion: the recursion at every order")
-           .check([](const Json& v) { return v == "auto" || v == "recursion"; }, "auto or recursion"),
+                    "auto: SPEC.md's closed formulas for orders 1-3, the derivative-free recursion along "
+                    "an averaged trajectory above; recursion: that recursion at every order; central: "
+                    "the recursion with central difference quotients at every order (5^(order-2) "
+                    "evaluations, for comparison)")
+           .choices({"auto", "recursion", "central"}),
        integer_or_string_param("reprepare", "never",
                                "re-prepare U from the solution (SPEC.md section 6): never (the paper's "
                                "schemes), every K steps (an integer), or auto (when tau_spread grows)")
@@ -82,8 +84,11 @@ void register_core(Registry& registry) {
     if (p.has("reprepare_defect")) repreparation.defect = p.number("reprepare_defect");
     if (p.has("reprepare_min_gap")) repreparation.min_gap = p.integer("reprepare_min_gap");
     if (p.has("reprepare_defect_floor")) repreparation.defect_floor = p.number("reprepare_defect_floor");
-    const bool recursion = p.has("initial_data_method") && p.string("initial_data_method") == "recursion";
-    return std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation, recursion);
+    const std::string method = p.has("initial_data_method") ? p.string("initial_data_method") : "auto";
+    const TwoScale::DataMethod data_method = method == "recursion" ? TwoScale::DataMethod::recursion
+                                             : method == "central" ? TwoScale::DataMethod::central
+                                                                   : TwoScale::DataMethod::automatic;
+    return std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation, data_method);
   };
   registry.add_reformulation(std::move(two_scale));
 

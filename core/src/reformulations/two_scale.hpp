@@ -1,8 +1,13 @@
 #pragma once
+#include <optional>
+#include <vector>
+
 #include "tsi/fft.hpp"
 #include "tsi/reformulation.hpp"
 
 namespace tsi {
+
+struct SigmaNodes;
 
 /// The two-scale reformulation (eq. 2scale eq): U(t, tau) on N_tau Fourier modes,
 ///     dU/dt = L U + f_tau(U),   L = -(1/eps) d/dtau + J R,
@@ -22,13 +27,19 @@ struct Repreparation {
 
 class TwoScale final : public Reformulation {
  public:
-  /// The largest order of prepared data (the recursion's cost grows as 5^(order - 2)).
+  /// The largest order of prepared data.
   static constexpr int max_data_order = 8;
 
-  /// `recursion`: prepared data from the derivative-free recursion at every order (else the
-  /// closed formulas of SPEC.md for orders 1-3, the recursion above).
+  /// How prepared data of order 2 and above is computed (docs/high-order.md, "Prepared data
+  /// of any order").
+  enum class DataMethod {
+    automatic,  ///< SPEC.md's closed formulas for orders 1-3, the recursion along a trajectory above
+    recursion,  ///< the recursion along an averaged trajectory at every order
+    central,    ///< the recursion with central difference quotients at every order (5^(k-2) evaluations)
+  };
+
   TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order,
-           Repreparation repreparation = {}, bool recursion = false);
+           Repreparation repreparation = {}, DataMethod data_method = DataMethod::automatic);
 
   Index size() const override { return dim_ * n_tau_; }
   const Vector& linear_multipliers() const override { return multipliers_; }
@@ -59,6 +70,8 @@ class TwoScale final : public Reformulation {
   Matrix to_grid(const Matrix& c);
   /// A = (d/dtau)^{-1} (I - Pi) on coefficients: mode k / (i k), modes 0 and Nyquist to 0.
   Matrix apply_A(Matrix c) const;
+  /// A's multiplier on the Fourier index j: 1 / (i k), 0 on modes 0 and Nyquist.
+  Complex antiderivative(int j) const;
   /// r1(w) = A f_.(w), as coefficients.
   Matrix r1(const Vector& w);
   /// r2(w) = A[Df(w) A f(w)] - A^2[Df(w) (Pi f(w) + JR w)] + JR A^2 f(w), as coefficients
@@ -69,24 +82,47 @@ class TwoScale final : public Reformulation {
   Vector prepared_at(const Vector& v, double s);
   /// The closed formulas of SPEC.md (orders 1-3), as coefficients.
   Matrix closed_data(const Vector& v, double s);
-  /// The derivative-free recursion (SPEC.md, "Higher order"), as coefficients.
-  Matrix recursive_data(const Vector& v, double s);
+  /// The derivative-free recursion (SPEC.md, "Higher order") to `order` with central
+  /// difference quotients, as coefficients.
+  Matrix central_data(const Vector& v, double s, int order);
   /// Phi^k(u): the mean-free tau dependence of data of order k at base point u, coefficients:
   ///   Phi^1 = 0,  Phi^k(u) = eps A [ f(u + Phi^{k-1}(u)) + JR Phi^{k-1}(u) - D Phi^{k-1}(u) G ],
   ///   G = Pi f(u + Phi^{k-1}(u)) + JR u,
   /// with D Phi^{k-1}(u) G a fourth-order central difference (see the definition).
-  Matrix phi(const Vector& u, int k);
+  Matrix central_phi(const Vector& u, int k);
+  /// The same recursion evaluated along one trajectory of the averaged flow, on which
+  /// D Phi^{k-1} G is d/dsigma (docs/high-order.md), as coefficients.
+  Matrix trajectory_data(const Vector& v, double s);
+  /// The averaged trajectory for trajectory_data: the points c_i = c(h x_i) of the trajectory
+  /// through the base point u = v - Phi(u)(s), found with the data themselves (one order of
+  /// Phi and one Picard step per sweep) from the line through v along `drift`, the averaged
+  /// field at v. Returns the points (u is points[nodes.center]), none where the sweeps diverge.
+  std::optional<std::vector<Vector>> averaged_trajectory(const Vector& v, double s, const SigmaNodes& nodes,
+                                                         double h, const Vector& drift);
+  /// One level of the recursion at every point c_i of a trajectory (or at `only` alone):
+  ///   next_i = eps A [ f(c_i + previous_i) + JR previous_i - (d/dsigma previous)(sigma_i) ],
+  /// with drift_i = Pi f(c_i + previous_i) + JR c_i, the averaged field there.
+  void trajectory_level(const std::vector<Vector>& points, const std::vector<Vector>& previous,
+                        const SigmaNodes& nodes, double h, std::vector<Vector>& next,
+                        std::vector<Vector>& drift, int only = -1);
+  /// The points u + int_0^{sigma_i} drift of the trajectory through u, by the interpolant of
+  /// the drift at the points (a Picard step).
+  std::vector<Vector> picard_step(const Vector& u, const std::vector<Vector>& drift, const SigmaNodes& nodes,
+                                  double h) const;
   /// The trigonometric interpolant of coefficients c at tau (Nyquist split half/half).
-  Vector evaluate(const Matrix& c, double tau) const;
+  Vector evaluate(ConstMatrixRef c, double tau) const;
 
-  /// N on the tau grid split over threads_: each thread transforms its rows and evaluates
-  /// the field on its columns (between barriers); the same numbers as the serial path.
-  void nonlinear_threaded(const Vector& y, Vector& out);
+  /// nonlinear_shifted on the tau grid split over threads_: each thread transforms its rows and
+  /// evaluates the field on its columns (between barriers); the same numbers as the serial path.
+  void nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out);
+  /// N(y + mean_shift), the shift added to the tau mean (column 0) of y on the way to the grid:
+  /// the prepared data evaluate f at c_i + Phi_i without a copy of Phi_i (none: nullptr).
+  void nonlinear_shifted(const Vector& y, const Vector* mean_shift, Vector& out);
 
   Index dim_;
   int n_tau_;
   int data_order_;
-  bool recursion_;
+  DataMethod data_method_;
   int data_order_reached_ = 0;  // the order the last preparation reached (recursion: may stop early)
   double eps_;
   RealVector taus_;

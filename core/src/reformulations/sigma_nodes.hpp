@@ -1,0 +1,18 @@
+#pragma once
+#include <Eigen/Dense>
+
+namespace tsi {
+
+/// Chebyshev-Lobatto points x_0 < ... < x_{m-1} on [-1, 1] (m odd, so that the middle one is
+/// 0) with the matrices that differentiate their interpolating polynomial at the points and
+/// integrate it from 0 to each point. The prepared data's averaged trajectory lives on them.
+struct SigmaNodes {
+  explicit SigmaNodes(int m);
+
+  Eigen::VectorXd x;
+  Eigen::MatrixXd differentiate;  ///< (D v)_i = p'(x_i), p the interpolant of the values v
+  Eigen::MatrixXd integrate;      ///< (S v)_i = int_0^{x_i} p
+  int center;                     ///< the index of x = 0
+};
+
+}  // namespace tsi
