@@ -16,6 +16,7 @@
 #include <optional>
 
 #include "tsi/error.hpp"
+#include "tsi/output.hpp"
 
 namespace tsi {
 namespace {
@@ -333,28 +334,19 @@ std::string npy_header(const std::string& descr, const std::vector<std::uint64_t
 }
 
 // Writes header + count values of item_size bytes, `fill(first, n, bytes)` putting values
-// first .. first + n - 1 into bytes; atomically, as write_file_atomically does.
+// first .. first + n - 1 into bytes; atomically, in chunks (write_file_atomically).
 void write_atomically(const std::string& path, const std::string& header, std::uint64_t count, std::size_t item_size,
                       const std::function<void(std::uint64_t, std::size_t, unsigned char*)>& fill) {
-  const std::string tmp = path + ".tmp." + std::to_string(getpid());
-  const auto fail = [&](int err) {
-    std::remove(tmp.c_str());
-    return IoError("cannot write " + path + ": " + std::strerror(err));
-  };
-  std::FILE* file = std::fopen(tmp.c_str(), "wb");
-  if (!file) throw IoError("cannot write " + path + ": " + std::strerror(errno));
-  bool written = std::fwrite(header.data(), 1, header.size(), file) == header.size();
-  std::vector<unsigned char> buffer(chunk_values * item_size);
-  for (std::uint64_t first = 0; written && first < count; first += chunk_values) {
-    const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(chunk_values, count - first));
-    fill(first, n, buffer.data());
-    written = std::fwrite(buffer.data(), item_size, n, file) == n;
-  }
-  written = written && std::fflush(file) == 0 && fsync(fileno(file)) == 0;
-  const int err = errno;
-  if (std::fclose(file) != 0 && written) throw fail(errno);
-  if (!written) throw fail(err);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw fail(errno);
+  write_file_atomically(path, [&](std::FILE* file) {
+    bool written = std::fwrite(header.data(), 1, header.size(), file) == header.size();
+    std::vector<unsigned char> buffer(chunk_values * item_size);
+    for (std::uint64_t first = 0; written && first < count; first += chunk_values) {
+      const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(chunk_values, count - first));
+      fill(first, n, buffer.data());
+      written = std::fwrite(buffer.data(), item_size, n, file) == n;
+    }
+    return written;
+  });
 }
 
 std::vector<std::uint64_t> checked_shape(const std::string& path, std::uint64_t count,

@@ -11,6 +11,12 @@
 namespace tsi {
 
 void write_file_atomically(const std::string& path, const std::string& contents) {
+  write_file_atomically(path, [&](std::FILE* file) {
+    return std::fwrite(contents.data(), 1, contents.size(), file) == contents.size();
+  });
+}
+
+void write_file_atomically(const std::string& path, const std::function<bool(std::FILE*)>& write) {
   const std::string tmp = path + ".tmp." + std::to_string(getpid());
   const auto fail = [&](int err) {
     std::remove(tmp.c_str());
@@ -18,8 +24,7 @@ void write_file_atomically(const std::string& path, const std::string& contents)
   };
   std::FILE* file = std::fopen(tmp.c_str(), "wb");
   if (!file) throw IoError("cannot write " + path + ": " + std::strerror(errno));
-  const bool written = std::fwrite(contents.data(), 1, contents.size(), file) == contents.size() &&
-                       std::fflush(file) == 0 && fsync(fileno(file)) == 0;
+  const bool written = write(file) && std::fflush(file) == 0 && fsync(fileno(file)) == 0;
   const int err = errno;
   if (std::fclose(file) != 0 && written) throw fail(errno);
   if (!written) throw fail(err);

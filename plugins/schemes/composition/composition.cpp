@@ -7,7 +7,6 @@
 // computed once.
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -70,12 +69,12 @@ class Composition final : public tsi::Stepper {
   Composition(tsi::Problem& problem, double h, const tsi::Scheme& base, const Method& method)
       : Stepper(problem, h) {
     for (double w : method.weights) {
-      const auto same = std::find(weights_.begin(), weights_.end(), w);
-      if (same == weights_.end()) {
+      const auto k = static_cast<size_t>(std::find(weights_.begin(), weights_.end(), w) - weights_.begin());
+      if (k == weights_.size()) {  // a new substep length
         weights_.push_back(w);
         bound_.push_back(base.bind(problem, w * h));
       }
-      substeps_.push_back(static_cast<size_t>(std::distance(weights_.begin(), std::find(weights_.begin(), weights_.end(), w))));
+      substeps_.push_back(k);
     }
   }
 
