@@ -1,4 +1,5 @@
 #include "tsi/fft.hpp"
+#include "tsi/real_fft.hpp"
 
 #include <fmt/format.h>
 
@@ -152,6 +153,82 @@ void FftBatch::forward_part(int p) {
 void FftBatch::backward_part(int p) {
   const auto i = static_cast<std::size_t>(p);
   transform_rows(part_rows_[i], part_rows_[i + 1] - part_rows_[i], 1, p);
+}
+
+}  // namespace tsi
+
+namespace tsi {
+namespace {
+// Rows per plan execution of a RealFftBatch: the rows of a block are adjacent in memory, so
+// each tau point of the block is one contiguous run of values.
+constexpr int real_block_rows = 8;
+}  // namespace
+
+RealFftBatch::RealFftBatch(int n, int howmany, int parts)
+    : n_(n), howmany_(howmany), block_(std::min(howmany, real_block_rows)) {
+  if (n <= 0 || n % 2 != 0 || howmany <= 0) throw Error("RealFftBatch: n must be positive and even, howmany positive");
+  if (parts < 1 || parts > howmany) throw Error("RealFftBatch: parts must be from 1 to the number of rows");
+  for (int p = 0; p <= parts; ++p) part_rows_.push_back(static_cast<int>(static_cast<long>(howmany) * p / parts));
+  std::lock_guard<std::mutex> lock(planner_mutex);
+  static const bool threads_ready = fftw_init_threads() != 0;
+  if (threads_ready) fftw_plan_with_nthreads(1);  // the callers' threads split the rows
+  // FFTW_ESTIMATE plans never touch the arrays they are made with, and FFTW_UNALIGNED plans
+  // run on any: small stand-ins serve for planning, the callers' arrays at execution.
+  double* real_standin = fftw_alloc_real(2);
+  fftw_complex* complex_standin = fftw_alloc_complex(2);
+  bool planned = real_standin && complex_standin;
+  const unsigned flags = FFTW_ESTIMATE | FFTW_UNALIGNED;
+  for (int rows : {block_, 1}) {  // a block, and single rows for a part's last ones
+    if (!planned) break;
+    void** plans = rows == block_ ? block_plans_ : row_plans_;
+    if (rows == 1 && block_ == 1) break;  // the block plans are the row plans
+    plans[0] = fftw_plan_many_dft_r2c(1, &n_, rows, real_standin, nullptr, howmany_, 1, complex_standin, nullptr,
+                                      howmany_, 1, flags);
+    plans[1] = fftw_plan_many_dft_c2r(1, &n_, rows, complex_standin, nullptr, howmany_, 1, real_standin, nullptr,
+                                      howmany_, 1, flags | FFTW_PRESERVE_INPUT);
+    planned = plans[0] && plans[1];
+  }
+  if (real_standin) fftw_free(real_standin);
+  if (complex_standin) fftw_free(complex_standin);
+  if (!planned) {
+    release();
+    throw Error(fmt::format("RealFftBatch: FFTW could not make a plan for {} x {}", n, howmany));
+  }
+}
+
+void RealFftBatch::release() {
+  for (void* plan : {block_plans_[0], block_plans_[1], row_plans_[0], row_plans_[1]})
+    if (plan) fftw_destroy_plan(as_plan(plan));
+}
+
+RealFftBatch::~RealFftBatch() {
+  std::lock_guard<std::mutex> lock(planner_mutex);
+  release();
+}
+
+void RealFftBatch::transform(const void* from, void* to, int direction, int part) const {
+  const int first = part < 0 ? 0 : part_rows_[static_cast<std::size_t>(part)];
+  const int last = part < 0 ? howmany_ : part_rows_[static_cast<std::size_t>(part) + 1];
+  const auto execute = [&](void* plan, int row) {
+    if (direction == 0)
+      fftw_execute_dft_r2c(as_plan(plan), const_cast<double*>(static_cast<const double*>(from)) + row,
+                           reinterpret_cast<fftw_complex*>(static_cast<Complex*>(to) + row));
+    else  // FFTW_PRESERVE_INPUT: the coefficients are only read
+      fftw_execute_dft_c2r(as_plan(plan),
+                           reinterpret_cast<fftw_complex*>(const_cast<Complex*>(static_cast<const Complex*>(from)) + row),
+                           static_cast<double*>(to) + row);
+  };
+  int row = first;
+  for (; row + block_ <= last; row += block_) execute(block_plans_[direction], row);
+  for (; row < last; ++row) execute(block_ == 1 ? block_plans_[direction] : row_plans_[direction], row);
+}
+
+void RealFftBatch::forward_unnormalised(const double* values, Complex* coefficients, int part) const {
+  transform(values, coefficients, 0, part);
+}
+
+void RealFftBatch::backward(const Complex* coefficients, double* values, int part) const {
+  transform(coefficients, values, 1, part);
 }
 
 }  // namespace tsi

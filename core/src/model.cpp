@@ -43,6 +43,10 @@ void Model::filtered_field(const RealVector& taus, MatrixRef states, MatrixRef o
   linear_flow(minus_taus, out);
 }
 
+void TauGridField::evaluate_real(RealMatrixRef, RealMatrixRef) {
+  throw Error("this tau-grid binding does not evaluate real grids (evaluates_real() is false)");
+}
+
 namespace {
 
 // The default binding: the model's filtered_field with the stored phases.

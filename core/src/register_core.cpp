@@ -54,7 +54,11 @@ void register_core(Registry& registry) {
            .range(0.0, 1.0, false, true),
        integer_param("reprepare_min_gap", 10, "auto: test (one evaluation of r1) every this many steps")
            .check([](const Json& v) { return v.get<long>() >= 1 && v.get<long>() <= 1000000000; },
-                  "an integer from 1 to 1e9")},
+                  "an integer from 1 to 1e9"),
+       bool_param("real_layout", true,
+                  "a real model keeps U(tau) real: the state holds tau modes 0 .. n_tau/2 and the "
+                  "transforms are real-to-complex (half the memory); false: all n_tau modes, as for a "
+                  "complex model (the same numbers to rounding)")},
       ""};
   two_scale.complete = [](Json& p, const Selection& s) {
     if (p["n_tau"].is_null()) p["n_tau"] = s.model.default_n_tau;
@@ -88,7 +92,8 @@ void register_core(Registry& registry) {
     const TwoScale::DataMethod data_method = method == "recursion" ? TwoScale::DataMethod::recursion
                                              : method == "central" ? TwoScale::DataMethod::central
                                                                    : TwoScale::DataMethod::automatic;
-    return std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation, data_method);
+    const bool real_layout = !p.has("real_layout") || p.boolean("real_layout");
+    return std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation, data_method, real_layout);
   };
   registry.add_reformulation(std::move(two_scale));
 

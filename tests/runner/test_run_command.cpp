@@ -157,7 +157,8 @@ TEST_CASE("run: output.every thins the rows of invariants.csv but keeps the last
 
 TEST_CASE("run: result.json reports the state's memory and the bound scheme's vectors of that size") {
   TempDir dir;
-  // Henon-Heiles: 4 unknowns x n_tau 16 complex values; SE1 holds 4 coefficients, 3 stage
+  // Henon-Heiles: a real model, 4 unknowns x (n_tau/2 + 1 = 9) complex values in the real
+  // layout (with real_layout false: n_tau = 16 of them); SE1 holds 4 coefficients, 3 stage
   // vectors and Picard's iterate; Anderson of depth 3 holds 4 + 2 x 3 instead of 1.
   for (const auto& [solver, vectors] : {std::pair{"picard", 8.0}, std::pair{"anderson", 17.0}}) {
     CAPTURE(solver);
@@ -168,10 +169,16 @@ TEST_CASE("run: result.json reports the state's memory and the bound scheme's ve
     INFO(r.describe());
     REQUIRE(r.exit_code == 0);
     const Json memory = read_json(fs::path(out) / "result.json")["memory"];
-    CHECK(memory["state_bytes"].get<double>() == 4 * 16 * 16);
+    CHECK(memory["state_bytes"].get<double>() == 4 * 9 * 16);
     CHECK(memory["stepper_state_vectors"].get<double>() == vectors);
     CHECK(memory["process_peak_rss_bytes"].get<double>() > 1e6);
   }
+  Json config = small_config();
+  config["reformulation"]["real_layout"] = false;
+  const std::string out = dir / "complex-layout";
+  const CommandResult r = run_tsi({"run", write_config(dir, config), "--out", out});
+  REQUIRE(r.exit_code == 0);
+  CHECK(read_json(fs::path(out) / "result.json")["memory"]["state_bytes"].get<double>() == 4 * 16 * 16);
 }
 
 TEST_CASE("run: aliases hh and se1-tsi are accepted and resolved to the canonical names") {

@@ -19,6 +19,12 @@ class TSI_API TauGridField {
   /// out.col(j) = f_{tau_j}(states.col(j)) for the bound phases tau_j. `states` is scratch:
   /// it may be left overwritten.
   virtual void evaluate(MatrixRef states, MatrixRef out) = 0;
+  /// True when the binding also evaluates real grids (evaluate_real): a real model's
+  /// two-scale problem keeps its tau grid real (half the memory and work of a complex one).
+  /// False by default: the reformulation then copies the real grid through complex buffers.
+  virtual bool evaluates_real() const { return false; }
+  /// evaluate on real grid values (real models that declare evaluates_real; the default throws).
+  virtual void evaluate_real(RealMatrixRef states, RealMatrixRef out);
 };
 
 /// A quantity a model declares as conserved (or nearly) besides H, I and m: runs record its

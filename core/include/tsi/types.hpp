@@ -13,6 +13,9 @@ using RealVector = Eigen::VectorXd;
 using Matrix = Eigen::MatrixXcd;
 using MatrixRef = Eigen::Ref<Matrix>;
 using ConstMatrixRef = Eigen::Ref<const Matrix>;
+/// A batch of real states (a real model's tau grid), one per column.
+using RealMatrix = Eigen::MatrixXd;
+using RealMatrixRef = Eigen::Ref<RealMatrix>;
 using Index = Eigen::Index;
 
 /// Real inner product <u, v> = Re sum conj(u_i) v_i.

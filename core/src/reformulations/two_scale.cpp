@@ -68,20 +68,21 @@ constexpr int central_fallback_order = 4;
 }  // namespace
 
 TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order,
-                   Repreparation repreparation, DataMethod data_method)
+                   Repreparation repreparation, DataMethod data_method, bool real_layout)
     : Reformulation(std::move(model)),
       dim_(model_->dim()),
       n_tau_(n_tau),
+      // A remainder turns coordinates by complex phases: its U is complex (a real model has none).
+      real_layout_(real_layout && !model_->is_complex() && !model_->has_linear_remainder() && n_tau > 0 &&
+                   n_tau % 2 == 0),
+      columns_(real_layout_ ? n_tau / 2 + 1 : n_tau),
       data_order_(initial_data_order),
       data_method_(data_method),
       eps_(model_->eps()),
       taus_(n_tau),
       remainder_(model_remainder(*model_)),
       wave_numbers_(n_tau),
-      multipliers_(dim_ * n_tau),
       threads_(grid_threads(*model_, n_tau)),
-      fft_(n_tau, static_cast<int>(model_->dim()), threads_),
-      field_fft_(n_tau, static_cast<int>(model_->dim()), threads_),
       repreparation_(repreparation) {
   if (n_tau <= 0 || n_tau % 2 != 0)
     throw ConfigError("reformulation.n_tau",
@@ -90,16 +91,32 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
     throw ConfigError("reformulation.initial_data_order", "got " + std::to_string(initial_data_order) +
                                                               ", expected an integer from 1 to " +
                                                               std::to_string(max_data_order));
-  if (remainder_.size()) remainder_grid_ = remainder_.replicate(n_tau, 1);
+  if (remainder_.size()) remainder_grid_ = remainder_.replicate(columns_, 1);
+  multipliers_.resize(size());
   for (int j = 0; j < n_tau; ++j) {
     taus_(j) = two_pi * j / n_tau;
     wave_numbers_(j) = j <= n_tau / 2 ? j : j - n_tau;
+    if (j >= columns_) continue;
     // Nyquist: -i k / eps is 0 there, as the Fourier differentiation matrix has it.
     const double k = (2 * j == n_tau) ? 0.0 : wave_numbers_(j);
     multipliers_.segment(j * dim_, dim_).setConstant(Complex(0.0, -k / eps_));
     if (remainder_.size()) multipliers_.segment(j * dim_, dim_) += remainder_;
   }
+  const int rows = static_cast<int>(dim_);
+  if (real_layout_) {
+    real_fft_ = std::make_unique<RealFftBatch>(n_tau, rows, threads_);
+    grid_values_.setZero(dim_, n_tau);
+    field_values_.setZero(dim_, n_tau);
+  } else {
+    fft_ = std::make_unique<FftBatch>(n_tau, rows, threads_);
+    field_fft_ = std::make_unique<FftBatch>(n_tau, rows, threads_);
+  }
   grid_field_ = model_->bind_tau_grid(taus_);
+  real_kernels_ = real_layout_ && grid_field_->evaluates_real();
+  if (real_layout_ && !real_kernels_) {
+    complex_grid_.setZero(dim_, n_tau);
+    complex_field_.setZero(dim_, n_tau);
+  }
   for (int p = 0; p <= threads_; ++p) column_begin_.push_back(static_cast<Index>(n_tau) * p / threads_);
   for (int p = 0; threads_ > 1 && p < threads_; ++p)
     column_fields_.push_back(model_->bind_tau_grid(taus_.segment(column_begin_[p], column_begin_[p + 1] - column_begin_[p])));
@@ -109,22 +126,23 @@ void TwoScale::nonlinear(double /*t*/, const Vector& y, Vector& out) { nonlinear
 
 void TwoScale::nonlinear_shifted(const Vector& y, const Vector* mean_shift, Vector& out) {
   ++evaluations_;
+  if (real_layout_) return nonlinear_real(y, mean_shift, out);
   if (threads_ > 1) return nonlinear_threaded(y, mean_shift, out);
-  auto grid = fft_.data();
-  auto field = field_fft_.data();
+  auto grid = fft_->data();
+  auto field = field_fft_->data();
   grid = Eigen::Map<const Matrix>(y.data(), dim_, n_tau_);
   if (mean_shift) grid.col(0) += *mean_shift;
-  fft_.backward();
+  fft_->backward();
   grid_field_->evaluate(grid, field);
-  field_fft_.forward_unnormalised();
+  field_fft_->forward_unnormalised();
   out.resize(size());
   Eigen::Map<Matrix>(out.data(), dim_, n_tau_) = field * (1.0 / n_tau_);  // the 1/n of the transform
 }
 
 void TwoScale::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out) {
   out.resize(size());
-  auto grid = fft_.data();
-  auto field = field_fft_.data();
+  auto grid = fft_->data();
+  auto field = field_fft_->data();
   const Eigen::Map<const Matrix> coefficients(y.data(), dim_, n_tau_);
   Eigen::Map<Matrix> result(out.data(), dim_, n_tau_);
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads_));
@@ -143,7 +161,7 @@ void TwoScale::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vec
       if (mean_shift && c0 == 0 && cn > 0) grid.col(0) += *mean_shift;
     });
     barrier();
-    parts([&](int p, Index, Index) { fft_.backward_part(p); });
+    parts([&](int p, Index, Index) { fft_->backward_part(p); });
     barrier();
     parts([&](int p, Index c0, Index cn) {
       try {
@@ -153,7 +171,7 @@ void TwoScale::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vec
       }
     });
     barrier();
-    parts([&](int p, Index, Index) { field_fft_.forward_part(p); });
+    parts([&](int p, Index, Index) { field_fft_->forward_part(p); });
     barrier();
     parts([&](int, Index c0, Index cn) { result.middleCols(c0, cn) = field.middleCols(c0, cn) * (1.0 / n_tau_); });
   }
@@ -161,11 +179,65 @@ void TwoScale::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vec
     if (error) std::rethrow_exception(error);
 }
 
+void TwoScale::nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& out) {
+  out.resize(size());
+  const auto transform_in = [&](int part) {
+    // The mean shift is a constant in tau: added to the grid values, as to the mean mode.
+    real_fft_->backward(y.data(), grid_values_.data(), part);
+    if (!mean_shift) return;
+    const Index r0 = part < 0 ? 0 : real_fft_->part_begin(part);
+    const Index rn = part < 0 ? dim_ : real_fft_->part_begin(part + 1) - r0;
+    grid_values_.middleRows(r0, rn).colwise() += mean_shift->segment(r0, rn).real();
+  };
+  const double scale = 1.0 / n_tau_;  // the 1/n of the transform
+  if (threads_ <= 1) {
+    transform_in(-1);
+    evaluate_real_grid(*grid_field_, 0, n_tau_);
+    real_fft_->forward_unnormalised(field_values_.data(), out.data());
+    out *= scale;
+    return;
+  }
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads_));
+  // As nonlinear_threaded: transforms by rows, the field by columns, barriers between.
+#if defined(_OPENMP)
+#pragma omp parallel num_threads(threads_)
+#endif
+  {
+    const auto parts = [&](auto&& work) {
+      for (int p = thread_index(); p < threads_; p += team_size()) work(p, column_begin_[p], column_begin_[p + 1] - column_begin_[p]);
+    };
+    parts([&](int p, Index, Index) { transform_in(p); });
+    barrier();
+    parts([&](int p, Index c0, Index cn) {
+      try {
+        evaluate_real_grid(*column_fields_[p], c0, cn);
+      } catch (...) {
+        errors[p] = std::current_exception();
+      }
+    });
+    barrier();
+    parts([&](int p, Index, Index) {
+      real_fft_->forward_unnormalised(field_values_.data(), out.data(), p);
+      const Index r0 = real_fft_->part_begin(p), rn = real_fft_->part_begin(p + 1) - r0;
+      Eigen::Map<Matrix>(out.data(), dim_, columns_).middleRows(r0, rn) *= scale;
+    });
+  }
+  for (const auto& error : errors)
+    if (error) std::rethrow_exception(error);
+}
+
+void TwoScale::evaluate_real_grid(TauGridField& field, Index c0, Index cn) {
+  if (real_kernels_) return field.evaluate_real(grid_values_.middleCols(c0, cn), field_values_.middleCols(c0, cn));
+  complex_grid_.middleCols(c0, cn) = grid_values_.middleCols(c0, cn).cast<Complex>();
+  field.evaluate(complex_grid_.middleCols(c0, cn), complex_field_.middleCols(c0, cn));
+  field_values_.middleCols(c0, cn) = complex_field_.middleCols(c0, cn).real();
+}
+
 void TwoScale::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& dy, Vector& out) {
-  const Matrix c = Eigen::Map<const Matrix>(y.data(), dim_, n_tau_);
-  const Matrix dc = Eigen::Map<const Matrix>(dy.data(), dim_, n_tau_);
+  const Matrix c = all_modes(Eigen::Map<const Matrix>(y.data(), dim_, columns_));
+  const Matrix dc = all_modes(Eigen::Map<const Matrix>(dy.data(), dim_, columns_));
   const Matrix result = df_coefficients(to_grid(c), to_grid(dc));
-  out = Eigen::Map<const Vector>(result.data(), size());
+  out = Eigen::Map<const Vector>(result.data(), size());  // modes 0 .. columns_ - 1
 }
 
 void TwoScale::rhs(double t, const Vector& y, Vector& out) {
@@ -174,10 +246,44 @@ void TwoScale::rhs(double t, const Vector& y, Vector& out) {
 }
 
 Matrix TwoScale::to_grid(const Matrix& c) {
-  auto buffer = fft_.data();
+  if (real_layout_) {
+    RealMatrix values(dim_, n_tau_);
+    real_fft_->backward(c.data(), values.data());  // modes 0 .. N/2: the first columns of c
+    return values.cast<Complex>();
+  }
+  auto buffer = fft_->data();
   buffer = c;
-  fft_.backward();
+  fft_->backward();
   return buffer;
+}
+
+Matrix TwoScale::to_coefficients(const Matrix& grid) {
+  if (real_layout_) {
+    const RealMatrix values = grid.real();
+    Matrix c(dim_, columns_);
+    real_fft_->forward_unnormalised(values.data(), c.data());
+    return all_modes(c / static_cast<double>(n_tau_));
+  }
+  auto buffer = fft_->data();
+  buffer = grid;
+  fft_->forward();
+  return buffer;
+}
+
+Matrix TwoScale::all_modes(ConstMatrixRef stored) const {
+  if (!real_layout_) return stored;
+  Matrix c(dim_, n_tau_);
+  c.leftCols(columns_) = stored;
+  for (int j = 1; 2 * j < n_tau_; ++j) c.col(n_tau_ - j) = stored.col(j).conjugate();
+  return c;
+}
+
+double TwoScale::coefficient_norm(const Vector& y, bool without_mean) const {
+  const Eigen::Map<const Matrix> c(y.data(), dim_, columns_);
+  double sum = 0.0;
+  for (int j = without_mean ? 1 : 0; j < columns_; ++j)
+    sum += (real_layout_ && j > 0 && 2 * j < n_tau_ ? 2.0 : 1.0) * c.col(j).squaredNorm();
+  return std::sqrt(sum);
 }
 
 Matrix TwoScale::f_coefficients(const Matrix& grid) {
@@ -185,10 +291,7 @@ Matrix TwoScale::f_coefficients(const Matrix& grid) {
   Matrix w = grid;
   Matrix f(dim_, n_tau_);
   grid_field_->evaluate(w, f);
-  auto buffer = fft_.data();
-  buffer = f;
-  fft_.forward();
-  return buffer;
+  return to_coefficients(f);
 }
 
 Matrix TwoScale::df_coefficients(const Matrix& grid, const Matrix& direction_grid) {
@@ -199,10 +302,7 @@ Matrix TwoScale::df_coefficients(const Matrix& grid, const Matrix& direction_gri
   Matrix df(dim_, n_tau_);
   model_->nonlinear_field_derivative(w, z, df);
   model_->linear_flow(RealVector(-taus_), df);
-  auto buffer = fft_.data();
-  buffer = df;
-  fft_.forward();
-  return buffer;
+  return to_coefficients(df);
 }
 
 Matrix TwoScale::apply_A(Matrix c) const {
@@ -233,13 +333,23 @@ Matrix TwoScale::r2(const Vector& w) {
 }
 
 double TwoScale::tau_spread(const Vector& y) const {
-  const Eigen::Map<const Matrix> c(y.data(), dim_, n_tau_);
-  const double total = c.squaredNorm();
-  return total > 0.0 ? (total - c.col(0).squaredNorm()) / total : 0.0;
+  const double total = std::pow(coefficient_norm(y), 2);
+  return total > 0.0 ? std::pow(coefficient_norm(y, true), 2) / total : 0.0;
 }
 
 Vector TwoScale::evaluate(ConstMatrixRef c, double tau) const {
   Vector value = Vector::Zero(dim_);
+  if (c.cols() != n_tau_) {  // the real layout: modes k and -k together, 2 Re(c_k e^{i k tau})
+    for (int j = 0; j < c.cols(); ++j) {
+      if (j == 0)
+        value += c.col(0).real().cast<Complex>();
+      else if (2 * j == n_tau_)
+        value += c.col(j).real().cast<Complex>() * std::cos(0.5 * n_tau_ * tau);
+      else
+        value += (2.0 * (c.col(j) * std::polar(1.0, j * tau)).real()).cast<Complex>();
+    }
+    return value;
+  }
   for (int j = 0; j < n_tau_; ++j) {
     if (2 * j == n_tau_)  // half at +n/2, half at -n/2: a real U stays real
       value += c.col(j) * std::cos(0.5 * n_tau_ * tau);
@@ -373,9 +483,8 @@ Matrix TwoScale::trajectory_data(const Vector& v, double s) {
   double last_correction = std::numeric_limits<double>::infinity();
   for (int k = 2; k <= data_order_; ++k) {
     trajectory_level(points, previous, nodes, h, next, drifts, k == data_order_ ? c : -1);
-    const Eigen::Map<const Matrix> top(next[c].data(), dim_, n_tau_);
-    Matrix candidate = top;
-    candidate.col(0) += v - evaluate(top, s);  // U(s) = v exactly
+    Matrix candidate = all_modes(Eigen::Map<const Matrix>(next[c].data(), dim_, columns_));
+    candidate.col(0) += v - evaluate(candidate, s);  // U(s) = v exactly
     const double correction = (candidate - data).norm();
     if (!keeps_decreasing(k, correction, last_correction, data.norm())) break;
     last_correction = correction;
@@ -404,11 +513,11 @@ std::optional<std::vector<Vector>> TwoScale::averaged_trajectory(const Vector& v
   double last_change = std::numeric_limits<double>::infinity();
   for (int sweep = 1; sweep <= max_sweeps; ++sweep) {
     trajectory_level(points, phi, nodes, h, next, drifts);
-    const Vector next_u = v - evaluate(Eigen::Map<const Matrix>(next[c].data(), dim_, n_tau_), s);
+    const Vector next_u = v - evaluate(Eigen::Map<const Matrix>(next[c].data(), dim_, columns_), s);
     std::vector<Vector> next_points = picard_step(next_u, drifts, nodes, h);
     double change = 0.0, moved = 0.0;
     for (int i = 0; i < m; ++i) {
-      change = std::max(change, (next[i] - phi[i]).norm());
+      change = std::max(change, coefficient_norm(next[i] - phi[i]));
       moved = std::max(moved, (next_points[i] - points[i]).norm());
     }
     // Near eps = 1 the sweeps can diverge with the asymptotic series: no trajectory then.
@@ -427,15 +536,15 @@ void TwoScale::trajectory_level(const std::vector<Vector>& points, const std::ve
                                 const SigmaNodes& nodes, double h, std::vector<Vector>& next,
                                 std::vector<Vector>& drift, int only) {
   const int m = static_cast<int>(points.size());
-  const auto phi = [&](int j) { return Eigen::Map<const Matrix>(previous[j].data(), dim_, n_tau_); };
+  const auto phi = [&](int j) { return Eigen::Map<const Matrix>(previous[j].data(), dim_, columns_); };
   for (int i = 0; i < m; ++i) {
     if (only >= 0 && i != only) continue;
     nonlinear_shifted(previous[i], &points[i], next[i]);  // f at c_i + previous_i(tau)
-    Eigen::Map<Matrix> rhs(next[i].data(), dim_, n_tau_);
+    Eigen::Map<Matrix> rhs(next[i].data(), dim_, columns_);
     drift[i] = rhs.col(0);
     if (remainder_.size()) drift[i] += remainder_.cwiseProduct(points[i]);
     // One pass per tau mode over the m points' data (each mode a few hundred kB at most).
-    for (int col = 0; col < n_tau_; ++col) {
+    for (int col = 0; col < columns_; ++col) {
       auto mode = rhs.col(col);
       const Complex factor = eps_ * antiderivative(col);
       if (factor == 0.0) {
@@ -465,16 +574,17 @@ bool TwoScale::between_steps(long n, double t, Vector& y) {
   if (repreparation_.mode == Repreparation::Mode::Auto && (n - last_prepared_) % repreparation_.min_gap != 0)
     return false;
   const double s = fast_phase(t, eps_);
-  const Vector v = evaluate(Eigen::Map<const Matrix>(y.data(), dim_, n_tau_), s);
+  const Vector v = evaluate(Eigen::Map<const Matrix>(y.data(), dim_, columns_), s);
   Vector prepared = prepared_at(v, s);
   if (repreparation_.mode == Repreparation::Mode::Auto) {
     // U is due when it has drifted off the prepared data through its own diagonal value by more
     // than a fraction of that data's tau variation (column 0 of the coefficients is the mean).
-    const double variation = prepared.segment(dim_, size() - dim_).norm();
+    const double variation = coefficient_norm(prepared, true);
     // A defect below defect_floor |U| is the scheme's own error, not the characteristics coming
     // apart (NLS at eps = 0.01: re-preparing on it made err_H 9x worse than never).
-    const double threshold = std::max(repreparation_.defect * variation, repreparation_.defect_floor * prepared.norm());
-    if (!((y - prepared).norm() > threshold)) return false;
+    const double threshold =
+        std::max(repreparation_.defect * variation, repreparation_.defect_floor * coefficient_norm(prepared));
+    if (!(coefficient_norm(y - prepared) > threshold)) return false;
   }
   y.swap(prepared);
   repreparation_times_.push_back(t);
@@ -484,14 +594,14 @@ bool TwoScale::between_steps(long n, double t, Vector& y) {
 
 Vector TwoScale::read_back(const Vector& y, double t) {
   const double tau = fast_phase(t, eps_);
-  return model_->linear_flow(tau, evaluate(Eigen::Map<const Matrix>(y.data(), dim_, n_tau_), tau));
+  return model_->linear_flow(tau, evaluate(Eigen::Map<const Matrix>(y.data(), dim_, columns_), tau));
 }
 
 double TwoScale::tau_roughness(const Vector& y) const {
-  const Eigen::Map<const Matrix> c(y.data(), dim_, n_tau_);
+  const Eigen::Map<const Matrix> c(y.data(), dim_, columns_);
   double total = 0.0, top = 0.0;
-  for (int j = 0; j < n_tau_; ++j) {
-    const double e = c.col(j).squaredNorm();
+  for (int j = 0; j < columns_; ++j) {
+    const double e = (real_layout_ && j > 0 && 2 * j < n_tau_ ? 2.0 : 1.0) * c.col(j).squaredNorm();
     total += e;
     if (8.0 * std::abs(wave_numbers_(j)) > 3.0 * n_tau_) top += e;  // |k| > 3/8 n: top quarter
   }

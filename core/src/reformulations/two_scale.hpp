@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "tsi/fft.hpp"
+#include "tsi/real_fft.hpp"
 #include "tsi/reformulation.hpp"
 
 namespace tsi {
@@ -14,6 +15,9 @@ struct SigmaNodes;
 /// stored as Fourier coefficients, d x N_tau column-major (column j = mode j), so that L is
 /// diagonal: -i k / eps + i omega_i for tau mode k and model coordinate i (omega: the model's
 /// remainder, zero without one). The Nyquist mode's -i k / eps is 0 (SPEC.md section 2).
+/// A real model's U(tau) is real: its coefficients are Hermitian (c_{-k} = conj c_k), and the
+/// state keeps modes k = 0 .. N_tau/2 only (d x (N_tau/2 + 1), the real layout: half the
+/// memory), transformed by real-to-complex FFTs on a real tau grid.
 /// When a two-scale run re-prepares its data (SPEC.md section 6, "Re-preparation").
 struct Repreparation {
   enum class Mode { Never, Every, Auto } mode = Mode::Never;
@@ -38,10 +42,15 @@ class TwoScale final : public Reformulation {
     central,    ///< the recursion with central difference quotients at every order (5^(k-2) evaluations)
   };
 
+  /// `real_layout`: keep a real model's state in the real layout (false: all N_tau modes, as
+  /// for a complex model; the same numbers to rounding).
   TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order,
-           Repreparation repreparation = {}, DataMethod data_method = DataMethod::automatic);
+           Repreparation repreparation = {}, DataMethod data_method = DataMethod::automatic,
+           bool real_layout = true);
 
-  Index size() const override { return dim_ * n_tau_; }
+  Index size() const override { return dim_ * columns_; }
+  /// True when the state holds modes 0 .. N_tau/2 of a real U (the real layout).
+  bool real_layout() const { return real_layout_; }
   const Vector& linear_multipliers() const override { return multipliers_; }
   const Vector& remainder_multipliers() const override { return remainder_grid_; }
   void nonlinear(double t, const Vector& y, Vector& out) override;
@@ -66,8 +75,20 @@ class TwoScale final : public Reformulation {
   Matrix f_coefficients(const Matrix& grid);
   /// Coefficients of Df_tau(W(tau)) Z(tau) for grid values W, Z.
   Matrix df_coefficients(const Matrix& grid, const Matrix& direction_grid);
-  /// Grid values of the coefficients c.
+  /// Grid values of the coefficients c (all N_tau modes).
   Matrix to_grid(const Matrix& c);
+  /// Coefficients (all N_tau modes) of grid values, normalised.
+  Matrix to_coefficients(const Matrix& grid);
+  /// All N_tau modes of coefficients in the state's layout (the real layout: the modes -k
+  /// are the conjugates of the modes k).
+  Matrix all_modes(ConstMatrixRef stored) const;
+  /// The norm of the coefficients of a state as if all N_tau modes were stored.
+  double coefficient_norm(const Vector& y, bool without_mean = false) const;
+  /// f_tau on the real tau grid (real layout): field_values_ = f(grid_values_) on columns
+  /// [c0, c0 + cn) with binding `field`.
+  void evaluate_real_grid(TauGridField& field, Index c0, Index cn);
+  /// nonlinear_shifted in the real layout.
+  void nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& out);
   /// A = (d/dtau)^{-1} (I - Pi) on coefficients: mode k / (i k), modes 0 and Nyquist to 0.
   Matrix apply_A(Matrix c) const;
   /// A's multiplier on the Fourier index j: 1 / (i k), 0 on modes 0 and Nyquist.
@@ -109,7 +130,8 @@ class TwoScale final : public Reformulation {
   /// the drift at the points (a Picard step).
   std::vector<Vector> picard_step(const Vector& u, const std::vector<Vector>& drift, const SigmaNodes& nodes,
                                   double h) const;
-  /// The trigonometric interpolant of coefficients c at tau (Nyquist split half/half).
+  /// The trigonometric interpolant of coefficients c at tau (Nyquist split half/half); c holds
+  /// all N_tau modes or the real layout's N_tau/2 + 1.
   Vector evaluate(ConstMatrixRef c, double tau) const;
 
   /// nonlinear_shifted on the tau grid split over threads_: each thread transforms its rows and
@@ -121,6 +143,8 @@ class TwoScale final : public Reformulation {
 
   Index dim_;
   int n_tau_;
+  bool real_layout_;
+  int columns_;  // stored tau modes: N_tau, or N_tau/2 + 1 in the real layout
   int data_order_;
   DataMethod data_method_;
   int data_order_reached_ = 0;  // the order the last preparation reached (recursion: may stop early)
@@ -134,8 +158,14 @@ class TwoScale final : public Reformulation {
   int threads_;  // threads on the tau grid (tsi::tau_grid_threads_for); 1: the serial path
   std::vector<Index> column_begin_;  // threads_ + 1 boundaries of the threads' tau columns
   std::vector<std::unique_ptr<TauGridField>> column_fields_;  // f_tau on each thread's columns
-  FftBatch fft_;        // U's coefficients -> its values on the tau grid
-  FftBatch field_fft_;  // f_tau(U) on the grid -> its coefficients: the model writes here
+  // Complex layout:
+  std::unique_ptr<FftBatch> fft_;        // U's coefficients -> its values on the tau grid
+  std::unique_ptr<FftBatch> field_fft_;  // f_tau(U) on the grid -> its coefficients: the model writes here
+  // Real layout:
+  std::unique_ptr<RealFftBatch> real_fft_;
+  RealMatrix grid_values_, field_values_;  // U and f_tau(U) on the real tau grid
+  bool real_kernels_ = false;  // the bindings evaluate real grids; otherwise through complex copies:
+  Matrix complex_grid_, complex_field_;
   Repreparation repreparation_;
   std::vector<double> repreparation_times_;
   long last_prepared_ = 0;  // the step of the last preparation

@@ -89,6 +89,8 @@ class ChargedParticle final : public tsi::Model {
     GridField(const ChargedParticle& model, const tsi::RealVector& taus)
         : model_(model), cos_((0.5 * taus.array()).cos()), sin_((0.5 * taus.array()).sin()) {}
     void evaluate(MatrixRef u, MatrixRef out) override { model_.fused_field(cos_, sin_, u, out); }
+    bool evaluates_real() const override { return true; }
+    void evaluate_real(tsi::RealMatrixRef u, tsi::RealMatrixRef out) override { model_.fused_field(cos_, sin_, u, out); }
 
    private:
     const ChargedParticle& model_;
@@ -102,7 +104,9 @@ class ChargedParticle final : public tsi::Model {
   bool independent_tau_grid_bindings() const override { return true; }
 
   // f_tau with c = cos(tau_j / 2), s = sin(tau_j / 2) given per column.
-  void fused_field(const tsi::RealVector& cos, const tsi::RealVector& sin, MatrixRef u, MatrixRef out) const {
+  // On complex or real grids (a real model's two-scale problem keeps its tau grid real).
+  template <class Grid>
+  void fused_field(const tsi::RealVector& cos, const tsi::RealVector& sin, Grid& u, Grid& out) const {
     const double two_eps = 2.0 * eps();
     constexpr Index block = 16;
     double x1[block], x2[block], k[block];
@@ -111,7 +115,8 @@ class ChargedParticle final : public tsi::Model {
       for (Index i = 0; i < m; ++i) {
         const Index j = j0 + i;
         const double c = cos(j), s = sin(j);
-        const double q1 = u(0, j).real(), q2 = u(1, j).real(), p1 = u(2, j).real(), p2 = u(3, j).real();
+        const double q1 = std::real(u(0, j)), q2 = std::real(u(1, j)), p1 = std::real(u(2, j)),
+                     p2 = std::real(u(3, j));
         const double a1 = c * q1 + s * p1, a2 = c * q2 + s * p2;
         x1[i] = c * a1 + s * a2;  // q of e^{JM tau} u
         x2[i] = -s * a1 + c * a2;

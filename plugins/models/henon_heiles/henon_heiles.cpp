@@ -55,6 +55,8 @@ class HenonHeiles final : public tsi::Model {
    public:
     explicit GridField(const tsi::RealVector& taus) : cos_(taus.array().cos()), sin_(taus.array().sin()) {}
     void evaluate(MatrixRef u, MatrixRef out) override { fused_field(cos_, sin_, u, out); }
+    bool evaluates_real() const override { return true; }
+    void evaluate_real(tsi::RealMatrixRef u, tsi::RealMatrixRef out) override { fused_field(cos_, sin_, u, out); }
 
    private:
     tsi::RealVector cos_, sin_;
@@ -67,11 +69,14 @@ class HenonHeiles final : public tsi::Model {
   bool independent_tau_grid_bindings() const override { return true; }
 
   // The three steps of f_tau in one pass: the flow turns (q1, p1) only, so the field needs
-  // the turned q1, and its (q1, p1) part, (0, -2 q1 q2), turns back by -tau.
-  static void fused_field(const tsi::RealVector& cos, const tsi::RealVector& sin, MatrixRef u, MatrixRef out) {
+  // the turned q1, and its (q1, p1) part, (0, -2 q1 q2), turns back by -tau. On complex or
+  // real grids (a real model's two-scale problem keeps its tau grid real).
+  template <class Grid>
+  static void fused_field(const tsi::RealVector& cos, const tsi::RealVector& sin, Grid& u, Grid& out) {
     for (Index j = 0; j < u.cols(); ++j) {
       const double c = cos(j), s = sin(j);
-      const double q1 = c * u(0, j).real() + s * u(2, j).real(), q2 = u(1, j).real(), p2 = u(3, j).real();
+      const double q1 = c * std::real(u(0, j)) + s * std::real(u(2, j)), q2 = std::real(u(1, j)),
+                   p2 = std::real(u(3, j));
       const double g = -2.0 * q1 * q2;
       out(0, j) = -s * g;
       out(1, j) = p2;
