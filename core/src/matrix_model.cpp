@@ -110,7 +110,14 @@ PeriodicMatrixFlow::PeriodicMatrixFlow(Matrix A, const std::string& path) : A_(s
   // The frequencies k of the eigenvalues i k, then P_k from e^{A tau_j} at N > 2 max|k| phases.
   const Eigen::ComplexEigenSolver<Matrix> solver(A_, false);
   std::set<long> ks;
-  for (Index i = 0; i < n; ++i) ks.insert(std::lround(solver.eigenvalues()(i).imag()));
+  for (Index i = 0; i < n; ++i) {
+    const double k = solver.eigenvalues()(i).imag();
+    if (!(std::fabs(k) <= 1e6))
+      throw ConfigError(path, fmt::format("has the eigenvalue {:.6g}i: frequencies up to 1e6 are taken (the fast "
+                                          "frequency is 1/eps: scale A so that it is)",
+                                          k));
+    ks.insert(std::lround(k));
+  }
   for (const long k : ks) max_frequency_ = std::max(max_frequency_, std::abs(k));
   long samples = 4;
   while (samples < 2 * max_frequency_ + 2) samples *= 2;
