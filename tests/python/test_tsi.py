@@ -511,6 +511,10 @@ class MatrixModelTests(unittest.TestCase):
         self.assertEqual(r.status, "failed")
         self.assertIn("deliberately broken", r.message)
 
+    def test_a_cpp_fields_name_is_refused(self):
+        with self.assertRaises(tsi.PluginError):
+            tsi.register_field("quickstart", quickstart_f)
+
     def test_the_wrong_size_is_refused(self):
         with self.assertRaises(tsi.ConfigError) as caught:
             tsi.run(self.config("py-quickstart", {"name": "se1"}, A=[[0, 1], [-1, 0]], u0=[1, 0]))
