@@ -27,8 +27,8 @@ Json info_json(const EntryInfo& info) {
 }
 
 void check_what(const std::string& what) {
-  if (!what.empty() && what != "models" && what != "reformulations" && what != "schemes")
-    throw ConfigError("list", "got \"" + what + "\", expected models, reformulations or schemes");
+  if (!what.empty() && what != "models" && what != "reformulations" && what != "schemes" && what != "fields")
+    throw ConfigError("list", "got \"" + what + "\", expected models, reformulations, schemes or fields");
 }
 
 }  // namespace
@@ -61,13 +61,23 @@ Json list_json(const Registry& registry, const std::string& what) {
       out["schemes"].push_back(j);
     }
   }
+  if (what.empty() || what == "fields") {
+    out["fields"] = Json::array();
+    for (const auto* e : registry.fields()) {
+      Json j = info_json(e->info);
+      j["dim"] = e->dim;
+      j["time_dependent"] = e->time_dependent;
+      j["is_complex"] = e->is_complex;
+      out["fields"].push_back(j);
+    }
+  }
   return out;
 }
 
 std::string list_text(const Registry& registry, const std::string& what) {
   const Json all = list_json(registry, what);
   std::string s;
-  for (const char* kind : {"models", "reformulations", "schemes"}) {
+  for (const char* kind : {"models", "reformulations", "schemes", "fields"}) {
     if (!all.contains(kind)) continue;
     s += fmt::format("{}{}:\n", s.empty() ? "" : "\n", kind);
     for (const auto& e : all[kind]) {
@@ -87,6 +97,10 @@ std::string list_text(const Registry& registry, const std::string& what) {
                          t["initial_data_order"].get<int>(), reforms);
       }
       if (e.contains("default_n_tau")) s += fmt::format("      default n_tau {}\n", e["default_n_tau"].get<int>());
+      if (e.contains("time_dependent"))
+        s += fmt::format("      {} entries, {}, {}\n", e["dim"].get<long>() == 0 ? std::string("any number of") : std::to_string(e["dim"].get<long>()),
+                         e["time_dependent"].get<bool>() ? "time-dependent" : "autonomous",
+                         e["is_complex"].get<bool>() ? "complex" : "real");
       for (const auto& p : e["params"]) {
         const std::string def = p["default"].is_null() ? "-" : p["default"].dump();
         s += fmt::format("      {:<20} {:<10} default {:<8} {}{}\n", p["name"].get<std::string>(),

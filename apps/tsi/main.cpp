@@ -108,10 +108,10 @@ int main(int argc, char** argv) {
                  "already share the cores)")
       ->check(CLI::Range(1, 1024));
 
-  auto* list = app.add_subcommand("list", "list registered models, reformulations and schemes");
+  auto* list = app.add_subcommand("list", "list registered models, reformulations, schemes and fields");
   std::string what;
   bool as_json = false;
-  list->add_option("what", what, "models, reformulations or schemes (default: all)");
+  list->add_option("what", what, "models, reformulations, schemes or fields (default: all)");
   list->add_flag("--json", as_json, "print JSON");
 
   auto* run = app.add_subcommand("run", "run one config and write result.json and invariants.csv");

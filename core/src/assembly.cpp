@@ -173,10 +173,10 @@ Vector initial_value_from_file(const Model& model, const std::string& file) {
     throw ConfigError("model.u0", e.what());
   }
   const std::string kind = model.is_complex() ? "complex" : "real";
-  if (header.count != static_cast<std::uint64_t>(model.dim()))
+  if (header.count != static_cast<std::uint64_t>(model.physical_dim()))
     throw refuse(fmt::format("{} values (shape {}), expected {} (the model's dimension: {} values in physical "
                              "variables, in any shape)",
-                             header.count, npy_shape_text(header.shape), model.dim(), kind));
+                             header.count, npy_shape_text(header.shape), model.physical_dim(), kind));
   NpyArray array;
   try {
     array = read_npy(file);
@@ -185,7 +185,7 @@ Vector initial_value_from_file(const Model& model, const std::string& file) {
   }
   const Vector& x = array.values;
   if (array.header.count != header.count)  // the file was replaced between the two reads
-    throw refuse(fmt::format("{} values, expected {}", array.header.count, model.dim()));
+    throw refuse(fmt::format("{} values, expected {}", array.header.count, model.physical_dim()));
   for (Index i = 0; i < x.size(); ++i) {
     const auto flat = static_cast<std::uint64_t>(i);
     if (!std::isfinite(x(i).real()) || !std::isfinite(x(i).imag()))
@@ -205,11 +205,11 @@ Vector initial_value(const Model& model, const Json& model_section) {
   if (!model_section.contains("u0") || model_section["u0"].is_null()) return model.initial_value();
   const Json& u0 = model_section["u0"];
   if (u0.is_string()) return initial_value_from_file(model, u0.get<std::string>());
-  if (!u0.is_array() || static_cast<Index>(u0.size()) != model.dim())
+  if (!u0.is_array() || static_cast<Index>(u0.size()) != model.physical_dim())
     throw ConfigError("model.u0", fmt::format("got {} entries, expected {} (the model's dimension)",
-                                              u0.is_array() ? u0.size() : 1, model.dim()));
-  Vector x(model.dim());
-  for (Index i = 0; i < model.dim(); ++i) {
+                                              u0.is_array() ? u0.size() : 1, model.physical_dim()));
+  Vector x(model.physical_dim());
+  for (Index i = 0; i < model.physical_dim(); ++i) {
     const Json& v = u0[static_cast<size_t>(i)];
     if (v.is_number())
       x(i) = v.get<double>();

@@ -70,7 +70,8 @@ void check_layout(const std::string& path, const TsiPluginLayout& theirs) {
       {"tsi::Params", &TsiPluginLayout::params},
       {"tsi::Vector", &TsiPluginLayout::vector},
       {"tsi::Json", &TsiPluginLayout::json},
-      {"std::string", &TsiPluginLayout::string}};
+      {"std::string", &TsiPluginLayout::string},
+      {"tsi::FieldEntry", &TsiPluginLayout::field_entry}};
   for (const auto& f : fields) {
     const TsiTypeLayout& a = theirs.*f.member;
     const TsiTypeLayout& b = ours.*f.member;

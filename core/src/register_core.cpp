@@ -3,6 +3,7 @@
 
 #include "reformulations/direct.hpp"
 #include "reformulations/filtered.hpp"
+#include "tsi/matrix_model.hpp"
 #include "tsi/registry.hpp"
 #include "reformulations/two_scale.hpp"
 
@@ -117,6 +118,8 @@ void register_core(Registry& registry) {
     return std::make_unique<Direct>(std::move(model), physical ? Direct::Variables::physical : Direct::Variables::model);
   };
   registry.add_reformulation(std::move(direct));
+
+  register_matrix_model(registry);
 
   registry.set_provider(previous);
 }

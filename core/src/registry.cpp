@@ -68,7 +68,9 @@ struct Table {
     const std::string hint = kind == "reformulation" ? ""
                                                      : "; a " + kind + " from a plugin needs the plugin loaded: --plugin "
                                                        "FILE, TSI_PLUGIN_PATH, the config's \"plugins\" list, or "
-                                                       "tsi.load_plugin(FILE) in Python";
+                                                       "tsi.load_plugin(FILE) in Python" +
+                                                       (kind == "field" ? std::string("; a field in Python: tsi.register_field")
+                                                                        : std::string());
     throw ConfigError(field, unknown + "valid " + plural + " are: " + list + hint);
   }
 
@@ -95,6 +97,7 @@ struct Registry::Impl {
   Table<ModelEntry> models{"model", "models", {}, {}};
   Table<ReformulationEntry> reformulations{"reformulation", "reformulations", {}, {}};
   Table<SchemeEntry> schemes{"scheme", "schemes", {}, {}};
+  Table<FieldEntry> fields{"field", "fields", {}, {}};
   std::string provider = "core";
 };
 
@@ -131,6 +134,11 @@ void Registry::add_scheme(SchemeEntry entry) {
   impl_->schemes.add(std::move(entry), impl_->provider);
 }
 
+void Registry::add_field(FieldEntry entry) {
+  if (!entry.create) throw PluginError("field \"" + entry.info.name + "\" has no create function");
+  impl_->fields.add(std::move(entry), impl_->provider);
+}
+
 const ModelEntry& Registry::model(const std::string& name, const std::string& field) const {
   return impl_->models.get(name, field);
 }
@@ -151,6 +159,12 @@ std::vector<const ReformulationEntry*> Registry::reformulations() const {
 }
 
 std::vector<const SchemeEntry*> Registry::schemes() const { return impl_->schemes.sorted(); }
+
+std::vector<const FieldEntry*> Registry::fields() const { return impl_->fields.sorted(); }
+
+const FieldEntry& Registry::field(const std::string& name, const std::string& path) const {
+  return impl_->fields.get(name, path);
+}
 
 void Registry::check_compatible(const SchemeEntry& scheme,
                                 const ReformulationEntry& reformulation) const {
@@ -176,6 +190,7 @@ void Registry::remove_provider(const std::string& provider) {
   impl_->models.remove_provider(provider);
   impl_->reformulations.remove_provider(provider);
   impl_->schemes.remove_provider(provider);
+  impl_->fields.remove_provider(provider);
 }
 
 }  // namespace tsi

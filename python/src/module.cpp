@@ -28,6 +28,7 @@
 #include "study_spec.hpp"
 #include "tsi/tau_grid_threads.hpp"
 #include "tsi/error.hpp"
+#include "tsi/matrix_model.hpp"
 #include "tsi/model.hpp"
 #include "tsi/plugin_loader.hpp"
 #include "tsi/registry.hpp"
@@ -304,6 +305,75 @@ void register_python_model(const std::string& name, py::object cls, const std::s
   registry.set_provider(previous);
 }
 
+// ---- Fields written in Python (f(t, u) of the "matrix" model) -------------------------------
+
+// f(t, u) as a Python callable: t a float64 array of n times, u a dim x n array (float64, or
+// complex128 for a complex field), one state per column; returns an array of u's shape.
+class PythonField final : public tsi::Field {
+ public:
+  PythonField(PyObject* function, std::string name, bool complex) : function_(function), name_(std::move(name)),
+                                                                   complex_(complex) {}
+  void evaluate(const tsi::RealVector& t, tsi::ConstMatrixRef states, tsi::MatrixRef out) const override {
+    py::gil_scoped_acquire gil;
+    try {
+      py::object u = complex_ ? py::cast(tsi::Matrix(states)) : py::cast(Eigen::MatrixXd(states.real()));
+      const tsi::Matrix m = py::handle(function_)(py::cast(t), u).cast<tsi::Matrix>();
+      if (m.rows() != out.rows() || m.cols() != out.cols())
+        throw tsi::Error(fmt::format("python field \"{}\": f(t, u) returned shape ({}, {}), expected ({}, {}): one "
+                                     "column per state",
+                                     name_, m.rows(), m.cols(), out.rows(), out.cols()));
+      out = m;
+    } catch (py::error_already_set& e) {
+      throw tsi::Error(fmt::format("python field \"{}\": f(t, u): {}", name_, e.what()));
+    } catch (const py::cast_error& e) {
+      throw tsi::Error(fmt::format("python field \"{}\": f(t, u) returned a value of the wrong type: {}", name_,
+                                   e.what()));
+    }
+  }
+
+ private:
+  PyObject* function_;  // owned by the registry entry, for the life of the process
+  std::string name_;
+  bool complex_;
+};
+
+// Registers (or re-registers) a Python function f(t, u) as field `name` for model.f.
+void register_python_field(const std::string& name, py::object function, long dim, bool time_dependent,
+                           bool is_complex, py::object u0, const std::string& summary) {
+  if (!PyCallable_Check(function.ptr()))
+    throw tsi::ConfigError("f", "got a value that is not callable, expected a function f(t, u)");
+  if (dim < 0 || dim > tsi::max_matrix_model_dim)
+    throw tsi::ConfigError("dim", fmt::format("got {}, expected 0 (any) or a size up to {}", dim, tsi::max_matrix_model_dim));
+  tsi::FieldEntry entry;
+  entry.info.name = name;
+  entry.info.summary = summary.empty() ? "a field f(t, u) written in Python" : summary;
+  entry.dim = dim;
+  entry.time_dependent = time_dependent;
+  entry.is_complex = is_complex;
+  if (!u0.is_none()) {
+    entry.initial_value = u0.cast<tsi::Vector>();
+    if (dim != 0 && entry.initial_value.size() != dim)
+      throw tsi::ConfigError("u0", fmt::format("has {} entries, expected dim = {}", entry.initial_value.size(), dim));
+    if (!entry.initial_value.allFinite()) throw tsi::ConfigError("u0", "has an entry that is not finite");
+  }
+  PyObject* function_ref = function.release().ptr();  // kept for the life of the process
+  entry.create = [function_ref, name, is_complex](tsi::Index) {
+    return std::make_shared<PythonField>(function_ref, name, is_complex);
+  };
+  tsi::Registry& registry = tsi::Registry::global();
+  const std::string provider = "python-field:" + name;
+  registry.remove_provider(provider);
+  const std::string previous = registry.provider();
+  registry.set_provider(provider);
+  try {
+    registry.add_field(std::move(entry));
+  } catch (...) {
+    registry.set_provider(previous);
+    throw;
+  }
+  registry.set_provider(previous);
+}
+
 // ---- Runs and studies -------------------------------------------------------------------------
 
 // A state as numpy (float64 for a real model, complex128 for a complex one, in the shape of
@@ -446,6 +516,9 @@ PYBIND11_MODULE(_tsi, m) {
   m.def("run", &run, py::arg("config"), py::arg("out") = "", py::arg("threads") = 0);
   m.def("study", &study, py::arg("spec"), py::arg("jobs") = 0, py::arg("overrides") = std::vector<std::string>(),
         py::arg("out") = "");
+  m.def("register_field", &register_python_field, py::arg("name"), py::arg("f"), py::arg("dim") = 0,
+        py::arg("time_dependent") = false, py::arg("is_complex") = false, py::arg("u0") = py::none(),
+        py::arg("summary") = "");
   m.def("register_model", &register_python_model, py::arg("name"), py::arg("cls"), py::arg("params") = "{}",
         py::arg("aliases") = std::vector<std::string>(), py::arg("n_tau") = 64, py::arg("nonlinearity_degree") = 0,
         py::arg("summary") = "");

@@ -27,7 +27,7 @@ from . import _tsi
 from ._tsi import ConfigError, Error, PluginError
 
 __version__ = _tsi.version
-__all__ = ["run", "study", "list", "load_plugin", "register_model", "RunResult", "StudyResult", "Error",
+__all__ = ["run", "study", "list", "load_plugin", "register_model", "register_field", "RunResult", "StudyResult", "Error",
            "ConfigError", "PluginError", "Interrupted", "plugin_directory"]
 
 for _warning in _tsi.init():
@@ -249,6 +249,30 @@ def register_model(name, cls=None, *, params=None, aliases=(), n_tau=64, nonline
         return c
 
     return register if cls is None else register(cls)
+
+
+def register_field(name, f=None, *, dim=0, time_dependent=False, is_complex=False, u0=None, summary=""):
+    """Registers a Python function f(t, u) as the field `name` of the "matrix" model, whose A is
+    a matrix in the run's config (a decorator when `f` is left out):
+
+        @tsi.register_field("my-f", dim=4)
+        def f(t, u):                  # t: n times, u: dim x n, one state per column
+            return np.array([0 * u[0], u[3], 2 * u[0] * u[1], -u[1] - u[0] ** 2 + u[1] ** 2])
+
+        tsi.run({"model": {"name": "matrix", "A": A, "f": "my-f", "eps": 1e-4, "u0": u0}, ...})
+
+    f returns an array of u's shape (float64 states, complex128 with is_complex). `dim`: the
+    number of entries it takes (0: any, A's size decides). `time_dependent`: f depends on t (the
+    model then carries t as one more variable; runs start at t = 0). `u0`: the default initial
+    value. Registering a name again replaces the earlier function; a plugin's name is refused.
+    """
+
+    def register(func):
+        _tsi.register_field(name, func, int(dim), bool(time_dependent), bool(is_complex),
+                            None if u0 is None else np.asarray(u0, dtype=complex), summary)
+        return func
+
+    return register if f is None else register(f)
 
 
 def __getattr__(name):

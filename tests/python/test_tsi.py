@@ -418,6 +418,109 @@ class PythonModelTests(unittest.TestCase):
             tsi.register_model("henon-heiles", HenonHeiles)
 
 
+QUICKSTART_A = [[0, 0, 1, 0], [0, 0, 0, 0], [-1, 0, 0, 0], [0, 0, 0, 0]]
+QUICKSTART_U0 = [0.55, 0.12, 0.03, 0.89]
+
+
+def quickstart_f(t, u):
+    """HOODESolver.jl's quickstart f(u) = (0, u4, 2 u1 u2, -u2 - u1^2 + u2^2), one state per column."""
+    u1, u2, u4 = u[0], u[1], u[3]
+    return np.array([np.zeros_like(u1), u4, 2 * u1 * u2, -u2 - u1 * u1 + u2 * u2])
+
+
+LINEAR_B = np.array([[0.12, -0.78, 0.91, 0.34], [-0.45, 0.56, 0.03, 0.54], [-0.67, 0.09, 0.18, 0.89],
+                     [-0.91, -0.56, 0.11, -0.56]])
+LINEAR_a = np.array([0.12, -0.98, 0.45, 0.26])
+LINEAR_b = np.array([-0.04, 0.48, 0.23, -0.87])
+LINEAR_U0 = [-0.34, 0.78, 0.67, -5.6]
+
+
+def linear_f(t, u):
+    """HOODESolver.jl's linear test f(t, u) = B u + t a + b (t: one time per column)."""
+    return LINEAR_B @ u + np.outer(LINEAR_a, t) + LINEAR_b[:, None]
+
+
+class MatrixModelTests(unittest.TestCase):
+    """The "matrix" model: A a matrix in the config, f a Python function (tsi.register_field)."""
+
+    @classmethod
+    def setUpClass(cls):
+        tsi.register_field("py-quickstart", quickstart_f, dim=4)
+        tsi.register_field("py-linear", linear_f, dim=4, time_dependent=True, u0=LINEAR_U0)
+
+    def config(self, f, scheme, h=0.1, **model):
+        return {"model": {"name": "matrix", "A": QUICKSTART_A, "f": f, "eps": 1e-4, "u0": QUICKSTART_U0, **model},
+                "reformulation": {"name": "two-scale", "n_tau": 32}, "scheme": scheme,
+                "time": {"h": h, "t_end": 3.0}}
+
+    def test_fields_are_listed(self):
+        names = {f["name"]: f for f in tsi.list("fields")}
+        self.assertIn("quickstart", names)
+        self.assertTrue(names["py-linear"]["time_dependent"])
+        self.assertEqual(names["py-quickstart"]["dim"], 4)
+
+    def test_python_f_agrees_with_the_cpp_field(self):
+        # The same JSON A with f in Python and with the core's C++ "quickstart" field.
+        for scheme in ({"name": "eab", "order": 4}, {"name": "collocation"}, {"name": "se1"}):
+            py = tsi.run(self.config("py-quickstart", scheme))
+            cpp = tsi.run(self.config("quickstart", scheme))
+            self.assertEqual(py.status, "completed", py.message)
+            self.assertNotIn("H", py.invariants)
+            difference = np.linalg.norm(py.u_final - cpp.u_final) / np.linalg.norm(cpp.u_final)
+            print(f"\n  {scheme['name']}: python f vs C++ f, relative difference {difference:.1e}")
+            self.assertLess(difference, 1e-12, scheme)
+
+    def test_a_numpy_matrix_is_taken(self):
+        r = tsi.run(self.config("py-quickstart", {"name": "se1"}, A=np.array(QUICKSTART_A, dtype=float)))
+        self.assertEqual(r.status, "completed")
+
+    def test_time_dependent_f_against_the_exact_solution(self):
+        # u(t) = e^{tC} u0 + C^{-1} (e^{tC} - I) b + (C^{-2} (e^{tC} - I) - t C^{-1}) a, C = A/eps + B:
+        # the exponential of the augmented matrix [[C, a, b], [0, 0, 1], [0, 0, 0]] applied to (u0, 0, 1),
+        # by eigen-decomposition (C has distinct eigenvalues).
+        eps, T = 0.015, 1.0
+        C = np.array(QUICKSTART_A, dtype=float) / eps + LINEAR_B
+        w, V = np.linalg.eig(C)
+        E = (V * np.exp(T * w)) @ np.linalg.inv(V)
+        Ci = np.linalg.inv(C)
+        exact = (E @ LINEAR_U0 + Ci @ (E - np.eye(4)) @ LINEAR_b
+                 + (Ci @ Ci @ (E - np.eye(4)) - T * Ci) @ LINEAR_a).real
+        errors = []
+        for h in (0.25, 0.125):
+            r = tsi.run({"model": {"name": "matrix", "A": QUICKSTART_A, "f": "py-linear", "eps": eps},
+                         "scheme": {"name": "eab", "order": 4}, "time": {"h": h, "t_end": T}})
+            self.assertEqual(r.status, "completed", r.message)
+            self.assertEqual(r.u_final.shape, (4,))
+            errors.append(np.linalg.norm(r.u_final - exact) / np.linalg.norm(exact))
+        order = np.log2(errors[0] / errors[1])
+        print(f"\n  eab order 4, eps = {eps}: errors {errors[0]:.2e} {errors[1]:.2e}, order {order:.2f}")
+        self.assertGreater(order, 3.5)
+
+    def test_a_non_periodic_A_is_refused(self):
+        with self.assertRaises(tsi.ConfigError) as caught:
+            tsi.run(self.config("py-quickstart", {"name": "se1"}, A=(1.1 * np.array(QUICKSTART_A)).tolist()))
+        self.assertEqual(caught.exception.field, "model.A")
+        self.assertIn("e^(2 pi A) differs from the identity", str(caught.exception))
+
+    def test_a_python_exception_fails_the_run_with_its_message(self):
+        def broken(t, u):
+            raise ValueError("deliberately broken")
+
+        tsi.register_field("py-broken-f", broken, dim=4)
+        r = tsi.run(self.config("py-broken-f", {"name": "se1"}))
+        self.assertEqual(r.status, "failed")
+        self.assertIn("deliberately broken", r.message)
+
+    def test_a_cpp_fields_name_is_refused(self):
+        with self.assertRaises(tsi.PluginError):
+            tsi.register_field("quickstart", quickstart_f)
+
+    def test_the_wrong_size_is_refused(self):
+        with self.assertRaises(tsi.ConfigError) as caught:
+            tsi.run(self.config("py-quickstart", {"name": "se1"}, A=[[0, 1], [-1, 0]], u0=[1, 0]))
+        self.assertEqual(caught.exception.field, "model.A")
+
+
 class InterruptTests(unittest.TestCase):
     def test_sigint_stops_a_run_and_keeps_what_it_computed(self):
         long_run = with_(HH, time={"h": 1 / 64, "t_end": 1e5})

@@ -173,7 +173,7 @@ TEST_CASE("list: an unknown kind is bad input") {
     CHECK(r.exit_code == 2);
     CHECK(contains(r.err, "tsi: error: list:"));
     CHECK(contains(r.err, "\"bogus\""));
-    CHECK(contains(r.err, "models, reformulations or schemes"));
+    CHECK(contains(r.err, "models, reformulations, schemes or fields"));
     CHECK(r.out.empty());
   }
 }

@@ -131,6 +131,10 @@ class TSI_API Model {
 
   /// The model's default initial value u0 (model variables).
   virtual Vector initial_value() const = 0;
+  /// Number of entries of a state in physical variables (u0 in a config, u_final, errors):
+  /// dim() by default. A model that carries more than the physical state (the matrix model
+  /// with a time-dependent f keeps t as one more variable) returns fewer.
+  virtual Index physical_dim() const { return dim(); }
   /// Model variables from a user-given initial value in physical variables (identity by default).
   virtual Vector from_physical(const Vector& x) const { return x; }
   /// The physical state errors and output are measured in (identity by default).

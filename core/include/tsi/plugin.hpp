@@ -40,6 +40,7 @@ struct TsiPluginLayout {
   TsiTypeLayout vector;               ///< tsi::Vector (Eigen::VectorXcd)
   TsiTypeLayout json;                 ///< tsi::Json (nlohmann::json)
   TsiTypeLayout string;               ///< std::string
+  TsiTypeLayout field_entry;          ///< tsi::FieldEntry
   /// EIGEN_MAX_ALIGN_BYTES: vectors resized by the plugin are freed by tsi and the other way
   /// round, so both must allocate with the same alignment.
   std::uint32_t eigen_max_align_bytes;
@@ -83,6 +84,7 @@ constexpr TsiPluginLayout tsi_plugin_layout() {
           layout_of<tsi::Vector>(),
           layout_of<tsi::Json>(),
           layout_of<std::string>(),
+          layout_of<tsi::FieldEntry>(),
           static_cast<std::uint32_t>(EIGEN_MAX_ALIGN_BYTES),
 #if defined(__SANITIZE_ADDRESS__)
           1u

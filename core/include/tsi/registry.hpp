@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "tsi/export.hpp"
+#include "tsi/field.hpp"
 #include "tsi/model.hpp"
 #include "tsi/params.hpp"
 #include "tsi/reformulation.hpp"
@@ -68,6 +69,20 @@ struct TSI_API ModelEntry {
   ModelFactory create;
 };
 
+/// A registered field f(t, u) (tsi/field.hpp): what a run names in model.f of the core's
+/// "matrix" model, whose A is a matrix in the run's JSON.
+struct TSI_API FieldEntry {
+  EntryInfo info;  ///< info.params is unused: a field has no parameters of its own
+  Index dim = 0;   ///< the number of entries of u it takes; 0: any (A's size decides)
+  bool time_dependent = false;  ///< f depends on t (the model then carries t as one more variable)
+  bool is_complex = false;      ///< f takes and gives complex states
+  /// The default u0 of a run with this field, in physical variables; empty: the run must
+  /// give model.u0.
+  Vector initial_value;
+  /// The field for states of `dim` entries (dim already checked against FieldEntry::dim).
+  std::function<std::shared_ptr<const Field>(Index dim)> create;
+};
+
 struct TSI_API ReformulationEntry {
   EntryInfo info;
   ReformulationFactory create;
@@ -105,17 +120,21 @@ class TSI_API Registry {
   void add_model(ModelEntry entry);
   void add_reformulation(ReformulationEntry entry);
   void add_scheme(SchemeEntry entry);
+  /// A field f(t, u) for the core's "matrix" model (model.f names it).
+  void add_field(FieldEntry entry);
 
   /// Look-ups by name or alias; `field` is the config path reported on a miss.
   const ModelEntry& model(const std::string& name, const std::string& field = "model.name") const;
   const ReformulationEntry& reformulation(const std::string& name,
                                           const std::string& field = "reformulation.name") const;
   const SchemeEntry& scheme(const std::string& name, const std::string& field = "scheme.name") const;
+  const FieldEntry& field(const std::string& name, const std::string& path = "model.f") const;
 
   /// Entries sorted by name.
   std::vector<const ModelEntry*> models() const;
   std::vector<const ReformulationEntry*> reformulations() const;
   std::vector<const SchemeEntry*> schemes() const;
+  std::vector<const FieldEntry*> fields() const;
 
   /// Refuses a scheme/reformulation pair the scheme does not support, naming the compatible
   /// reformulations.
@@ -136,7 +155,9 @@ class TSI_API Registry {
 /// (degree d needs (d + 2) / 2 nodes); 6 for a non-polynomial one.
 TSI_API int default_quadrature_nodes(const ModelEntry& model);
 
-/// Registers the three reformulations of the core (two-scale, filtered, direct).
+/// Registers the core's entries: the three reformulations (two-scale, filtered, direct), the
+/// "matrix" model (A from the run's JSON, f a registered field) and its built-in field
+/// "quickstart".
 TSI_API void register_core(Registry& registry);
 
 }  // namespace tsi

@@ -13,9 +13,10 @@ namespace {
 // T(a + 2b) against T(a) + 2 T(b) for two states of the model's kind: a linear T agrees to
 // rounding, an affine or nonlinear one does not.
 void require_linear_to_physical(const Model& model) {
-  const Vector a = model.initial_value();
-  Vector b(a.size());
+  // Two states of the model's dimension (not its initial value: a model may have no default).
+  Vector a(model.dim()), b(model.dim());
   for (Index i = 0; i < a.size(); ++i) {
+    a(i) = 0.1 + 0.9 * static_cast<double>(i % 7) / 7.0;
     const double w = 0.3 + 0.7 * static_cast<double>(i + 1) / static_cast<double>(a.size());
     b(i) = model.is_complex() ? Complex(w, 0.5 * w) : Complex(w, 0.0);
   }
@@ -42,8 +43,13 @@ Direct::Direct(std::shared_ptr<const Model> model, Variables variables)
       au_(model_->dim()),
       remainder_(model_remainder(*model_)) {
   if (physical_) {
+    if (model_->physical_dim() != model_->dim())
+      throw ConfigError("reformulation.variables",
+                        fmt::format("got \"physical\", but the model's state has {} entries and its physical "
+                                    "state {} (it carries t for a time-dependent field): use \"model\"",
+                                    model_->dim(), model_->physical_dim()));
     require_linear_to_physical(*model_);
-    size_ = model_->to_physical(model_->initial_value()).size();
+    size_ = model_->physical_dim();
   }
 }
 
