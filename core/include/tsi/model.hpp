@@ -19,6 +19,10 @@ class TSI_API TauGridField {
   /// out.col(j) = f_{tau_j}(states.col(j)) for the bound phases tau_j. `states` is scratch:
   /// it may be left overwritten.
   virtual void evaluate(MatrixRef states, MatrixRef out) = 0;
+  /// True when evaluate(states, out) may be called with out and states the same matrix (each
+  /// column read before it is written): the two-scale problem then evaluates in the caller's
+  /// vector and holds no grid buffer of its own.
+  virtual bool in_place() const { return false; }
 };
 
 /// A quantity a model declares as conserved (or nearly) besides H, I and m: runs record its

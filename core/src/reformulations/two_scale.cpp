@@ -12,6 +12,7 @@
 
 #include "remainder.hpp"
 #include "sigma_nodes.hpp"
+#include "tsi/algebra.hpp"
 #include "tsi/error.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/tau_grid_threads.hpp"
@@ -78,7 +79,6 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
       taus_(n_tau),
       remainder_(model_remainder(*model_)),
       wave_numbers_(n_tau),
-      multipliers_(dim_ * n_tau),
       threads_(grid_threads(*model_, n_tau)),
       fft_(n_tau, static_cast<int>(model_->dim()), threads_),
       field_fft_(n_tau, static_cast<int>(model_->dim()), threads_),
@@ -91,18 +91,48 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
                                                               ", expected an integer from 1 to " +
                                                               std::to_string(max_data_order));
   if (remainder_.size()) remainder_grid_ = remainder_.replicate(n_tau, 1);
+  const Index run = remainder_.size() ? 1 : diagonal_run(*model_);
+  Vector multipliers(run == 1 ? dim_ * n_tau : n_tau);
   for (int j = 0; j < n_tau; ++j) {
     taus_(j) = two_pi * j / n_tau;
     wave_numbers_(j) = j <= n_tau / 2 ? j : j - n_tau;
     // Nyquist: -i k / eps is 0 there, as the Fourier differentiation matrix has it.
     const double k = (2 * j == n_tau) ? 0.0 : wave_numbers_(j);
-    multipliers_.segment(j * dim_, dim_).setConstant(Complex(0.0, -k / eps_));
-    if (remainder_.size()) multipliers_.segment(j * dim_, dim_) += remainder_;
+    if (run > 1) {
+      multipliers(j) = Complex(0.0, -k / eps_);
+      continue;
+    }
+    multipliers.segment(j * dim_, dim_).setConstant(Complex(0.0, -k / eps_));
+    if (remainder_.size()) multipliers.segment(j * dim_, dim_) += remainder_;
   }
+  multipliers_ = Diagonal(std::move(multipliers), run);
   grid_field_ = model_->bind_tau_grid(taus_);
   for (int p = 0; p <= threads_; ++p) column_begin_.push_back(static_cast<Index>(n_tau) * p / threads_);
   for (int p = 0; threads_ > 1 && p < threads_; ++p)
     column_fields_.push_back(model_->bind_tau_grid(taus_.segment(column_begin_[p], column_begin_[p + 1] - column_begin_[p])));
+}
+
+Index TwoScale::diagonal_run(const Model& model) {
+  return model_remainder(model).size() == 0 && model.dim() >= min_diagonal_run ? model.dim() : 1;
+}
+
+double TwoScale::work_vectors(const Model& model, int initial_data_order, const std::string& data_method,
+                              double* preparation) {
+  // The closed formulas (orders 2, 3) hold at most 4 grids at once (r2), the central quotients
+  // a grid per level of their recursion and its quotient's four, the recursion along a
+  // trajectory the previous and the next level at its m points (trajectory_data).
+  const bool remainder = model_remainder(model).size() > 0;
+  double prepare = 2.0;
+  if (initial_data_order >= 2) {
+    if (data_method == "central")
+      prepare = 3.0 + 2.0 * initial_data_order;
+    else if (data_method == "recursion" || initial_data_order > 3)
+      prepare = 2.0 * trajectory_point_count(initial_data_order, remainder) + 3.0;
+    else
+      prepare = initial_data_order == 3 ? 5.0 : 2.0;
+  }
+  if (preparation) *preparation = prepare;
+  return 1.0 + (remainder ? 2.0 : 0.0) + prepare;
 }
 
 void TwoScale::nonlinear(double /*t*/, const Vector& y, Vector& out) { nonlinear_shifted(y, nullptr, out); }
@@ -110,15 +140,20 @@ void TwoScale::nonlinear(double /*t*/, const Vector& y, Vector& out) { nonlinear
 void TwoScale::nonlinear_shifted(const Vector& y, const Vector* mean_shift, Vector& out) {
   ++evaluations_;
   if (threads_ > 1) return nonlinear_threaded(y, mean_shift, out);
-  auto grid = fft_.data();
-  auto field = field_fft_.data();
-  grid = Eigen::Map<const Matrix>(y.data(), dim_, n_tau_);
-  if (mean_shift) grid.col(0) += *mean_shift;
-  fft_.backward();
-  grid_field_->evaluate(grid, field);
-  field_fft_.forward_unnormalised();
+  // The grid in out's storage: the tau transforms go through their small blocks, and a model
+  // that evaluates in place needs no grid of the state's size besides out.
   out.resize(size());
-  Eigen::Map<Matrix>(out.data(), dim_, n_tau_) = field * (1.0 / n_tau_);  // the 1/n of the transform
+  fft_.transform(y.data(), out.data(), 1, 1.0, mean_shift ? mean_shift->data() : nullptr);
+  Eigen::Map<Matrix> grid(out.data(), dim_, n_tau_);
+  Complex* field = out.data();
+  if (grid_field_->in_place()) {
+    grid_field_->evaluate(grid, grid);
+  } else {
+    field_.resize(dim_, n_tau_);
+    grid_field_->evaluate(grid, field_);
+    field = field_.data();
+  }
+  fft_.transform(field, out.data(), 0, 1.0 / n_tau_);  // the 1/n of the transform
 }
 
 void TwoScale::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out) {
@@ -170,39 +205,40 @@ void TwoScale::nonlinear_derivative(double /*t*/, const Vector& y, const Vector&
 
 void TwoScale::rhs(double t, const Vector& y, Vector& out) {
   nonlinear(t, y, out);
-  out += multipliers_.cwiseProduct(y);
+  algebra::diagonal_multiply_add(out, multipliers_, y, out);
 }
 
 Matrix TwoScale::to_grid(const Matrix& c) {
-  auto buffer = fft_.data();
-  buffer = c;
-  fft_.backward();
-  return buffer;
+  Matrix grid(dim_, n_tau_);
+  fft_.transform(c.data(), grid.data(), 1);
+  return grid;
 }
 
-Matrix TwoScale::f_coefficients(const Matrix& grid) {
+Matrix TwoScale::f_coefficients(Matrix w) {
   ++evaluations_;
-  Matrix w = grid;
+  if (grid_field_->in_place()) {
+    grid_field_->evaluate(w, w);
+    fft_.transform(w.data(), w.data(), 0, 1.0 / n_tau_);
+    return w;
+  }
   Matrix f(dim_, n_tau_);
   grid_field_->evaluate(w, f);
-  auto buffer = fft_.data();
-  buffer = f;
-  fft_.forward();
-  return buffer;
+  w.resize(0, 0);
+  fft_.transform(f.data(), f.data(), 0, 1.0 / n_tau_);
+  return f;
 }
 
-Matrix TwoScale::df_coefficients(const Matrix& grid, const Matrix& direction_grid) {
+Matrix TwoScale::df_coefficients(Matrix w, Matrix z) {
   ++evaluations_;
-  Matrix w = grid, z = direction_grid;
   model_->linear_flow(taus_, w);
   model_->linear_flow(taus_, z);
   Matrix df(dim_, n_tau_);
   model_->nonlinear_field_derivative(w, z, df);
+  w.resize(0, 0);
+  z.resize(0, 0);
   model_->linear_flow(RealVector(-taus_), df);
-  auto buffer = fft_.data();
-  buffer = df;
-  fft_.forward();
-  return buffer;
+  fft_.transform(df.data(), df.data(), 0, 1.0 / n_tau_);
+  return df;
 }
 
 Matrix TwoScale::apply_A(Matrix c) const {
@@ -222,13 +258,16 @@ Complex TwoScale::antiderivative(int j) const {
 Matrix TwoScale::r1(const Vector& w) { return apply_A(f_coefficients(w.replicate(1, n_tau_))); }
 
 Matrix TwoScale::r2(const Vector& w) {
-  const Matrix w_grid = w.replicate(1, n_tau_);
-  const Matrix f = f_coefficients(w_grid);
-  const Matrix af_grid = to_grid(apply_A(f));
+  // At most four grids at once: the constant grid of w is made again for each use.
+  Matrix f = f_coefficients(w.replicate(1, n_tau_));
   Vector drift = f.col(0);  // the averaged field at w, Pi f(w) + JR w: constant in tau
   if (remainder_.size()) drift += remainder_.cwiseProduct(w);
-  Matrix r = apply_A(df_coefficients(w_grid, af_grid)) - apply_A(apply_A(df_coefficients(w_grid, drift.replicate(1, n_tau_))));
-  if (remainder_.size()) r += remainder_.asDiagonal() * apply_A(apply_A(f));
+  Matrix remainder_term;
+  if (remainder_.size()) remainder_term = remainder_.asDiagonal() * apply_A(apply_A(f));
+  Matrix af_grid = to_grid(apply_A(std::move(f)));
+  Matrix r = apply_A(df_coefficients(w.replicate(1, n_tau_), std::move(af_grid)));
+  r -= apply_A(apply_A(df_coefficients(w.replicate(1, n_tau_), drift.replicate(1, n_tau_))));
+  if (remainder_.size()) r += remainder_term;
   return r;
 }
 
@@ -264,20 +303,25 @@ Vector TwoScale::prepared_at(const Vector& v, double s) {
     c = trajectory_data(v, s);
   else
     c = closed_data(v, s);
-  return Eigen::Map<const Vector>(c.data(), size());
+  Vector out = Eigen::Map<const Vector>(c.data(), size());
+  return out;
 }
 
 Matrix TwoScale::closed_data(const Vector& v, double s) {
-  Matrix c = Matrix::Zero(dim_, n_tau_);
+  Matrix c;
+  if (data_order_ < 2) c = Matrix::Zero(dim_, n_tau_);
   if (data_order_ >= 2) {
     // eq. (2nd data) centred at s; order 3 evaluates r1 at vbar = v - eps r1(v)(s) and adds
     // eps^2 r2(v). s = 0 is the initial data.
     Matrix r = r1(v);
     if (data_order_ == 3) {
       const Vector vbar = v - eps_ * evaluate(r, s);
-      r = r1(vbar) + eps_ * r2(v);
+      r.resize(0, 0);  // r2's grids next, without it
+      r = eps_ * r2(v);
+      r = r1(vbar) + r;
     }
-    c = eps_ * r;
+    r *= eps_;
+    c = std::move(r);
     c.col(0) -= evaluate(c, s);  // U(s) = v exactly: subtract the value at tau = s
   }
   c.col(0) += v;
@@ -340,13 +384,16 @@ Matrix TwoScale::trajectory_data(const Vector& v, double s) {
   // + JR Phi^{k-1}(c_i) - (d/dsigma Phi^{k-1})(c_i) ], one evaluation per point and level. One
   // trajectory serves every level: a G off by dG costs eps^2 dG (eps A, and D Phi = O(eps)), so
   // the trajectory of the most accurate averaged field serves all orders below it.
-  Matrix data = Matrix::Zero(dim_, n_tau_);
-  data.col(0) = v;
   data_order_reached_ = 1;
-  if (data_order_ < 2) return data;
-  const Matrix f = f_coefficients(v.replicate(1, n_tau_));
+  if (data_order_ < 2) {
+    Matrix data = Matrix::Zero(dim_, n_tau_);
+    data.col(0) = v;
+    return data;
+  }
+  Matrix f = f_coefficients(v.replicate(1, n_tau_));
   if (data_order_ == 2) {  // Phi^2 = eps A f needs no trajectory
-    Matrix phi = eps_ * apply_A(f);
+    Matrix phi = apply_A(std::move(f));
+    phi *= eps_;
     phi.col(0) += v - evaluate(phi, s);
     data_order_reached_ = 2;
     return phi;
@@ -357,6 +404,7 @@ Matrix TwoScale::trajectory_data(const Vector& v, double s) {
   const bool remainder = remainder_.size() > 0;
   const SigmaNodes nodes(trajectory_point_count(data_order_, remainder));
   Vector drift = f.col(0);
+  f.resize(0, 0);
   if (remainder) drift += remainder_.cwiseProduct(v);
   const double speed = drift.norm() / v.norm();
   const double length = trajectory_length(static_cast<int>(nodes.x.size()), remainder);
@@ -369,6 +417,8 @@ Matrix TwoScale::trajectory_data(const Vector& v, double s) {
   // order 4 (38 evaluations: orders beyond it gain nothing there).
   if (!trajectory) return central_data(v, s, std::min(data_order_, central_fallback_order));
   const std::vector<Vector>& points = *trajectory;
+  Matrix data = Matrix::Zero(dim_, n_tau_);
+  data.col(0) = v;
   std::vector<Vector> previous(m, Vector::Zero(size())), next(m, Vector(size())), drifts(m);
   double last_correction = std::numeric_limits<double>::infinity();
   for (int k = 2; k <= data_order_; ++k) {

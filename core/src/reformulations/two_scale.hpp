@@ -1,5 +1,6 @@
 #pragma once
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "tsi/fft.hpp"
@@ -29,6 +30,19 @@ class TwoScale final : public Reformulation {
  public:
   /// The largest order of prepared data.
   static constexpr int max_data_order = 8;
+  /// Models of at least this many unknowns without a remainder store L (and the schemes their
+  /// coefficients) once per tau mode; smaller ones per unknown (their vectors are small, and
+  /// whole-vector products are faster there than runs of a few entries).
+  static constexpr Index min_diagonal_run = 64;
+  /// The run of L's diagonal for this model (tsi::Diagonal::run): dim, or 1.
+  static Index diagonal_run(const Model& model);
+  /// The vectors of its size a two-scale problem holds besides the state at the peak of a run,
+  /// known before it is built: its work space (a grid buffer where the model's field is not
+  /// evaluated in place, allowed for here; a remainder's multipliers) and the largest
+  /// preparation of data of this order and method (their temporaries; freed before the run's
+  /// steps). `preparation` gets the latter alone.
+  static double work_vectors(const Model& model, int initial_data_order, const std::string& data_method,
+                             double* preparation = nullptr);
 
   /// How prepared data of order 2 and above is computed (docs/high-order.md, "Prepared data
   /// of any order").
@@ -42,7 +56,7 @@ class TwoScale final : public Reformulation {
            Repreparation repreparation = {}, DataMethod data_method = DataMethod::automatic);
 
   Index size() const override { return dim_ * n_tau_; }
-  const Vector& linear_multipliers() const override { return multipliers_; }
+  const Diagonal& linear_multipliers() const override { return multipliers_; }
   const Vector& remainder_multipliers() const override { return remainder_grid_; }
   void nonlinear(double t, const Vector& y, Vector& out) override;
   void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
@@ -62,10 +76,11 @@ class TwoScale final : public Reformulation {
   int threads() const override { return threads_; }
 
  private:
-  /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau).
-  Matrix f_coefficients(const Matrix& grid);
-  /// Coefficients of Df_tau(W(tau)) Z(tau) for grid values W, Z.
-  Matrix df_coefficients(const Matrix& grid, const Matrix& direction_grid);
+  /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau), computed in W's storage where
+  /// the model evaluates in place.
+  Matrix f_coefficients(Matrix grid);
+  /// Coefficients of Df_tau(W(tau)) Z(tau) for grid values W, Z (consumed).
+  Matrix df_coefficients(Matrix grid, Matrix direction_grid);
   /// Grid values of the coefficients c.
   Matrix to_grid(const Matrix& c);
   /// A = (d/dtau)^{-1} (I - Pi) on coefficients: mode k / (i k), modes 0 and Nyquist to 0.
@@ -129,13 +144,14 @@ class TwoScale final : public Reformulation {
   Vector remainder_;  // i omega per model coordinate (empty without a remainder)
   std::unique_ptr<TauGridField> grid_field_;  // f_tau on taus_, bound once
   RealVector wave_numbers_;  // k of each Fourier index; the Nyquist index holds n/2
-  Vector multipliers_;
+  Diagonal multipliers_;  // per tau mode without a remainder (diagonal_run), else per unknown
   Vector remainder_grid_;  // remainder_ on every tau point (empty without a remainder)
   int threads_;  // threads on the tau grid (tsi::tau_grid_threads_for); 1: the serial path
   std::vector<Index> column_begin_;  // threads_ + 1 boundaries of the threads' tau columns
   std::vector<std::unique_ptr<TauGridField>> column_fields_;  // f_tau on each thread's columns
   FftBatch fft_;        // U's coefficients -> its values on the tau grid
-  FftBatch field_fft_;  // f_tau(U) on the grid -> its coefficients: the model writes here
+  FftBatch field_fft_;  // f_tau(U) on the grid -> its coefficients: the model writes here (threads)
+  Matrix field_;        // the field on the grid where the model does not evaluate in place (first use)
   Repreparation repreparation_;
   std::vector<double> repreparation_times_;
   long last_prepared_ = 0;  // the step of the last preparation
