@@ -122,23 +122,29 @@ FftBatch::~FftBatch() {
 
 Eigen::Map<Matrix> FftBatch::data() { return Eigen::Map<Matrix>(buffer(), howmany_, n_); }
 
-void FftBatch::transform(const Complex* from, Complex* to, int direction, double scale, const Complex* shift) {
+void FftBatch::transform(const Complex* from, Complex* to, int direction, double scale, const Complex* shift,
+                         int part) {
   const std::size_t stride = static_cast<std::size_t>(howmany_);
+  const int first = part < 0 ? 0 : part_rows_[static_cast<std::size_t>(part)];
+  const int last = part < 0 ? howmany_ : part_rows_[static_cast<std::size_t>(part) + 1];
   if (blocks_.empty()) {  // strided: through the buffer the plans were made on
     Eigen::Map<Matrix> buf = data();
-    if (from != buffer_) buf = Eigen::Map<const Matrix>(from, howmany_, n_);
-    if (shift) buf.col(0) += Eigen::Map<const Vector>(shift, howmany_);
-    fftw_execute(as_plan(plans_[direction]));
+    const bool whole = part < 0 || part_plans_.empty();
+    const int r0 = whole ? 0 : first, rows = whole ? howmany_ : last - first;
+    auto part_rows = buf.middleRows(r0, rows);
+    if (from != buffer_) part_rows = Eigen::Map<const Matrix>(from, howmany_, n_).middleRows(r0, rows);
+    if (shift) part_rows.col(0) += Eigen::Map<const Vector>(shift, howmany_).segment(r0, rows);
+    fftw_execute(as_plan(whole ? plans_[direction] : part_plans_[2 * static_cast<std::size_t>(part) + direction]));
     if (scale != 1.0)
-      Eigen::Map<Matrix>(to, howmany_, n_) = buf * scale;
+      Eigen::Map<Matrix>(to, howmany_, n_).middleRows(r0, rows) = part_rows * scale;
     else if (to != buffer_)
-      Eigen::Map<Matrix>(to, howmany_, n_) = buf;
+      Eigen::Map<Matrix>(to, howmany_, n_).middleRows(r0, rows) = part_rows;
     return;
   }
   // Rows r .. r + k - 1 into the block, transposed (each row's n points contiguous), and back.
-  Complex* b = blocks_[0];
-  for (int r = 0; r < howmany_; r += block_rows) {
-    const int k = std::min(block_rows, howmany_ - r);
+  Complex* b = blocks_[part < 0 ? 0 : static_cast<std::size_t>(part)];
+  for (int r = first; r < last; r += block_rows) {
+    const int k = std::min(block_rows, last - r);
     const Complex* in = from + r;
     for (int j = 0; j < n_; ++j)
       for (int i = 0; i < k; ++i) b[static_cast<std::size_t>(i) * n_ + j] = in[j * stride + i];

@@ -38,7 +38,10 @@ class TSI_API FftBatch {
   /// without the batch's buffer where it is buffered: forward (direction 0, unnormalised) or
   /// backward (1), with `shift` (howmany values, or null) added to column 0 on the way in and
   /// every result multiplied by `scale` on the way out (the same products as a pass after).
-  void transform(const Complex* from, Complex* to, int direction, double scale = 1.0, const Complex* shift = nullptr);
+  /// With `part` (0 <= part < parts()) only that part's rows, through its own block: parts may
+  /// be transformed at the same time on different threads.
+  void transform(const Complex* from, Complex* to, int direction, double scale = 1.0, const Complex* shift = nullptr,
+                 int part = -1);
   /// Values at tau_j = 2*pi*j/n -> Fourier coefficients (normalised by 1/n).
   void forward();
   /// The same without the 1/n: for callers that fold the normalisation into their next pass.

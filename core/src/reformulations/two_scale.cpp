@@ -81,7 +81,6 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
       wave_numbers_(n_tau),
       threads_(grid_threads(*model_, n_tau)),
       fft_(n_tau, static_cast<int>(model_->dim()), threads_),
-      field_fft_(n_tau, static_cast<int>(model_->dim()), threads_),
       repreparation_(repreparation) {
   if (n_tau <= 0 || n_tau % 2 != 0)
     throw ConfigError("reformulation.n_tau",
@@ -157,15 +156,19 @@ void TwoScale::nonlinear_shifted(const Vector& y, const Vector* mean_shift, Vect
 }
 
 void TwoScale::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out) {
+  // As the serial path: the grid in out's storage, each thread's rows transformed through its
+  // own block, the field in place where the model allows it.
   out.resize(size());
-  auto grid = fft_.data();
-  auto field = field_fft_.data();
-  const Eigen::Map<const Matrix> coefficients(y.data(), dim_, n_tau_);
-  Eigen::Map<Matrix> result(out.data(), dim_, n_tau_);
+  const bool in_place = std::all_of(column_fields_.begin(), column_fields_.end(),
+                                    [](const std::unique_ptr<TauGridField>& f) { return f->in_place(); });
+  if (!in_place) field_.resize(dim_, n_tau_);
+  Eigen::Map<Matrix> grid(out.data(), dim_, n_tau_);
+  Complex* field = in_place ? out.data() : field_.data();
+  const Complex* shift = mean_shift ? mean_shift->data() : nullptr;
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads_));
-  // Copies go by columns (contiguous), transforms by rows; every phase reads what the one
-  // before wrote on other threads, hence the barriers. A team smaller than asked for (an
-  // OpenMP limit) takes several parts per thread.
+  // Transforms go by rows, the field by columns; every phase reads what the one before wrote
+  // on other threads, hence the barriers. A team smaller than asked for (an OpenMP limit)
+  // takes several parts per thread.
 #if defined(_OPENMP)
 #pragma omp parallel num_threads(threads_)
 #endif
@@ -173,24 +176,20 @@ void TwoScale::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vec
     const auto parts = [&](auto&& work) {
       for (int p = thread_index(); p < threads_; p += team_size()) work(p, column_begin_[p], column_begin_[p + 1] - column_begin_[p]);
     };
-    parts([&](int, Index c0, Index cn) {
-      grid.middleCols(c0, cn) = coefficients.middleCols(c0, cn);
-      if (mean_shift && c0 == 0 && cn > 0) grid.col(0) += *mean_shift;
-    });
-    barrier();
-    parts([&](int p, Index, Index) { fft_.backward_part(p); });
+    parts([&](int p, Index, Index) { fft_.transform(y.data(), out.data(), 1, 1.0, shift, p); });
     barrier();
     parts([&](int p, Index c0, Index cn) {
       try {
-        column_fields_[p]->evaluate(grid.middleCols(c0, cn), field.middleCols(c0, cn));
+        if (in_place)
+          column_fields_[p]->evaluate(grid.middleCols(c0, cn), grid.middleCols(c0, cn));
+        else
+          column_fields_[p]->evaluate(grid.middleCols(c0, cn), field_.middleCols(c0, cn));
       } catch (...) {
         errors[p] = std::current_exception();
       }
     });
     barrier();
-    parts([&](int p, Index, Index) { field_fft_.forward_part(p); });
-    barrier();
-    parts([&](int, Index c0, Index cn) { result.middleCols(c0, cn) = field.middleCols(c0, cn) * (1.0 / n_tau_); });
+    parts([&](int p, Index, Index) { fft_.transform(field, out.data(), 0, 1.0 / n_tau_, nullptr, p); });
   }
   for (const auto& error : errors)
     if (error) std::rethrow_exception(error);

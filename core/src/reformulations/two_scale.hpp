@@ -149,9 +149,8 @@ class TwoScale final : public Reformulation {
   int threads_;  // threads on the tau grid (tsi::tau_grid_threads_for); 1: the serial path
   std::vector<Index> column_begin_;  // threads_ + 1 boundaries of the threads' tau columns
   std::vector<std::unique_ptr<TauGridField>> column_fields_;  // f_tau on each thread's columns
-  FftBatch fft_;        // U's coefficients -> its values on the tau grid
-  FftBatch field_fft_;  // f_tau(U) on the grid -> its coefficients: the model writes here (threads)
-  Matrix field_;        // the field on the grid where the model does not evaluate in place (first use)
+  FftBatch fft_;   // the tau transforms, both ways, in threads_ parts (from and to the caller's memory)
+  Matrix field_;   // the field on the grid where the model does not evaluate in place (first use)
   Repreparation repreparation_;
   std::vector<double> repreparation_times_;
   long last_prepared_ = 0;  // the step of the last preparation
