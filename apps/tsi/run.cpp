@@ -234,9 +234,12 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   result["config"] = config;
   result["warnings"] = Json::array();
   const auto start = Clock::now();
-  // Construction: bad input (a model's own checks, u0 of the wrong shape) is a ConfigError
-  // that propagates before anything runs.
-  Assembly assembly = assemble(config, registry);
+  // Construction: bad input (a model's own checks, u0 of the wrong shape, a run that cannot fit
+  // in memory) is a ConfigError that propagates before anything runs. The scheme is bound after
+  // the data are prepared: the preparation's temporaries are gone by then.
+  AssemblyOptions assembly_options;
+  assembly_options.bind = false;
+  Assembly assembly = assemble(config, registry, assembly_options);
   // A reference that could not finish is refused now, not after the run.
   check_run_steps(config);
   if (config.contains("reference") && !shared_reference) check_reference_cost(config, registry);
@@ -255,7 +258,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
                                                 H0, I0, m0));
   }
   Reformulation* reformulation = assembly.reformulation.get();
-  Stepper* stepper = assembly.stepper.get();
+  Stepper* stepper = nullptr;  // bound once the data are prepared
 
   const auto& rconf = config["reformulation"];
   if (rconf.contains("initial_data_order") &&
@@ -315,6 +318,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
             "expansion beyond that order",
             data_order, rconf["initial_data_order"].get<int>(), model->eps()));
     }
+    stepper = &assembly.bind(config["time"]["h"].get<double>());
     integrate(*stepper, y, n_steps, [&](long n, double t, const Vector& state) {
       const bool go_on = recorder.observe(n, t, state);
       if (go_on && interrupted()) {  // kept up to this step, and written as "interrupted"
@@ -380,7 +384,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
       result["invariants"][names[k]]["drift"] = std::isnan(d) ? Json() : Json(d);
     }
   }
-  const SolverStats stats = stepper->stats();
+  const SolverStats stats = stepper ? stepper->stats() : SolverStats{};
   Json histogram = Json::object();
   for (size_t k = 0; k < stats.sweeps_histogram.size(); ++k)
     if (stats.sweeps_histogram[k] > 0) histogram[std::to_string(k)] = stats.sweeps_histogram[k];
@@ -406,8 +410,10 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     result["memory"] = {{"state_bytes", state_bytes},
-                        {"stepper_state_vectors", stepper->state_vectors()},
+                        {"stepper_state_vectors", stepper ? stepper->state_vectors() : assembly.footprint.scheme_vectors},
                         {"process_peak_rss_bytes", static_cast<double>(usage.ru_maxrss) * 1024.0}};
+    // The footprint the run was checked against before it was built (two-scale runs).
+    if (assembly.footprint.vectors > 0.0) result["memory"]["footprint_vectors"] = assembly.footprint.vectors;
   }
 
   if (outcome.ok && config.contains("reference")) {

@@ -50,6 +50,7 @@ class HenonHeilesEnsemble final : public tsi::Model {
     explicit GridField(const tsi::RealVector& taus) : cos_(taus.array().cos()), sin_(taus.array().sin()) {}
     void evaluate(MatrixRef u, MatrixRef out) override { fused_field(cos_, sin_, u, out); }
     bool evaluates_real() const override { return true; }
+    bool in_place() const override { return true; }  // each column read before it is written
     void evaluate_real(tsi::RealMatrixRef u, tsi::RealMatrixRef out) override { fused_field(cos_, sin_, u, out); }
 
    private:

@@ -12,6 +12,8 @@ using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, max
 using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_depth, 1>;
 }  // namespace
 
+double AndersonSolver::state_vectors_for(int depth) { return 4.0 + 2.0 * std::clamp(depth, 1, max_depth); }
+
 AndersonSolver::AndersonSolver(FixedPointOptions options)
     : FixedPointSolver(options), depth_(std::clamp(options.anderson_depth, 1, max_depth)) {}
 

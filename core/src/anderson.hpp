@@ -12,7 +12,9 @@ namespace tsi {
 class AndersonSolver final : public FixedPointSolver {
  public:
   explicit AndersonSolver(FixedPointOptions options);
-  double state_vectors() const override { return 4.0 + 2.0 * depth_; }
+  double state_vectors() const override { return state_vectors_for(depth_); }
+  /// Its vectors with this depth (clamped as the solver clamps it).
+  static double state_vectors_for(int depth);
 
  protected:
   int iterate(Vector& x, FixedPointMap g, double& increment) override;

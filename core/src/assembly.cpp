@@ -12,6 +12,7 @@
 
 #include "tsi/error.hpp"
 #include "tsi/npy.hpp"
+#include "reformulations/two_scale.hpp"
 
 namespace tsi {
 namespace {
@@ -65,20 +66,64 @@ double available_bytes() {
                                : std::numeric_limits<double>::infinity();
 }
 
-// A two-scale run holds about two dozen vectors of dim x n_tau complex values (the state, a
-// scheme's stages and coefficients, the tau transforms, a spatial model's grid batches):
-// refused before any of them is allocated when that cannot fit.
-void check_footprint(const Model& model, const Json& reformulation) {
-  if (!reformulation.contains("n_tau") || !reformulation["n_tau"].is_number()) return;
-  constexpr double vectors = 24.0, bytes_per_value = 16.0;
-  const double n_tau = reformulation["n_tau"].get<double>(), dim = static_cast<double>(model.dim());
-  const double needed = vectors * bytes_per_value * dim * n_tau, available = available_bytes();
-  if (needed > available)
-    throw ConfigError("reformulation.n_tau",
-                      fmt::format("got {:.0f}: with the model's {:.0f} unknowns a run needs about {:.3g} GB "
-                                  "({:.0f} x {:.0f} complex values, two dozen times), and this machine has "
-                                  "{:.3g} GB available",
-                                  n_tau, dim, needed / 1e9, dim, n_tau, available / 1e9));
+}  // namespace
+
+Footprint two_scale_footprint(const Model& model, const Json& reformulation, const Scheme& scheme,
+                              const std::string& scheme_name, bool bound_before_preparation) {
+  Footprint f;
+  if (!reformulation.contains("n_tau") || !reformulation["n_tau"].is_number()) return f;
+  f.dim = static_cast<double>(model.dim());
+  f.n_tau = reformulation["n_tau"].get<double>();
+  // A real model's state holds tau modes 0 .. n_tau/2 (the real layout).
+  const auto real_layout = reformulation.find("real_layout");
+  const bool real = TwoScale::real_layout_for(model) &&
+                    !(real_layout != reformulation.end() && real_layout->is_boolean() && !real_layout->get<bool>());
+  const double modes = real ? f.n_tau / 2 + 1 : f.n_tau;
+  f.state_bytes = 16.0 * f.dim * modes;
+  f.scheme = scheme_name;
+  // The layout the problem will have, from the sizes alone (nothing of them allocated yet).
+  const double size = f.dim * modes;
+  const bool per_tau_mode = TwoScale::diagonal_run(model) > 1;
+  ProblemLayout layout;
+  layout.size = static_cast<Index>(std::min(size, 9e18));
+  layout.diagonal_values = per_tau_mode ? static_cast<Index>(modes) : layout.size;
+  f.scheme_vectors = scheme.state_vectors(layout);
+  const int order = reformulation.value("initial_data_order", 1);
+  const std::string method = reformulation.value("initial_data_method", std::string("auto"));
+  double preparation = 0.0;
+  const double work = TwoScale::work_vectors(model, order, method, &preparation);
+  f.problem_vectors = work - preparation;
+  f.preparation_vectors = preparation;
+  if (real) {
+    // The preparation's grids hold all n_tau modes (n_tau / modes states each); the problem
+    // holds the real grid and, where its binding does not evaluate in place, the real field.
+    f.preparation_vectors *= f.n_tau / modes;
+    f.problem_vectors = 2.0;
+  }
+  // A run prepares its data before it binds the scheme (the preparation's grids are freed by
+  // then); bound first, both are held at once.
+  f.vectors = 1.0 + f.problem_vectors +
+              (bound_before_preparation ? f.scheme_vectors + f.preparation_vectors
+                                        : std::max(f.scheme_vectors, f.preparation_vectors));
+  return f;
+}
+
+namespace {
+
+// Refused before anything of the state's size is allocated when the run cannot fit.
+void check_footprint(const Footprint& f, double limit) {
+  if (f.state_bytes <= 0.0) return;
+  const bool machine = !(limit > 0.0);
+  const double available = machine ? available_bytes() : limit;
+  if (!(f.bytes() > available)) return;
+  throw ConfigError(
+      "reformulation.n_tau",
+      fmt::format("got {:.0f}: with the model's {:.0f} unknowns a run needs about {:.3g} GB: {:.3g} vectors of "
+                  "{:.0f} x {:.0f} complex values ({:.3g} GB each; tau modes 0 .. n_tau/2 for a real model): the state, {:.3g} of scheme \"{}\", {:.3g} of "
+                  "the two-scale problem and {:.3g} of its prepared data; {} has {:.3g} GB available",
+                  f.n_tau, f.dim, f.bytes() / 1e9, f.vectors, f.dim, f.state_bytes / (16.0 * f.dim), f.state_bytes / 1e9, f.scheme_vectors,
+                  f.scheme, f.problem_vectors, f.preparation_vectors,
+                  machine ? std::string("this machine") : std::string("the memory limit"), available / 1e9));
 }
 
 // Whether a model's "u0" is the common parameter (an array, or the name of a .npy file); a
@@ -224,16 +269,22 @@ Vector initial_value(const Model& model, const Json& model_section) {
   return model.from_physical(x);
 }
 
-Assembly assemble(const Json& resolved, const Registry& registry) {
+Assembly assemble(const Json& resolved, const Registry& registry, const AssemblyOptions& options) {
   Assembly a;
   a.model_entry = &registry.model(resolved.at("model").at("name"));
   a.reformulation_entry = &registry.reformulation(resolved.at("reformulation").at("name"));
   a.scheme_entry = &registry.scheme(resolved.at("scheme").at("name"));
   a.model = a.model_entry->create(Params(without_name(resolved["model"])));
   a.u0 = initial_value(*a.model, resolved["model"]);
-  check_footprint(*a.model, resolved["reformulation"]);
-  a.reformulation = a.reformulation_entry->create(a.model, Params(without_name(resolved["reformulation"])));
   a.traits = scheme_traits(*a.scheme_entry, without_name(resolved["scheme"]));
+  // The scheme first (its parameters only): its vector count for the problem's layout sizes the
+  // footprint, checked before the reformulation allocates anything of the state's size.
+  a.scheme = a.scheme_entry->create(Params(without_name(resolved["scheme"])));
+  const bool binds = options.bind && resolved.contains("time") && resolved["time"].contains("h") &&
+                     resolved["time"]["h"].is_number();
+  a.footprint = two_scale_footprint(*a.model, resolved["reformulation"], *a.scheme, a.scheme_entry->info.name, binds);
+  check_footprint(a.footprint, options.memory_bytes);
+  a.reformulation = a.reformulation_entry->create(a.model, Params(without_name(resolved["reformulation"])));
   const StepperTraits& traits = a.traits;
   const std::string pair = fmt::format("model \"{}\" on the \"{}\" reformulation", a.model_entry->info.name,
                                        a.reformulation_entry->info.name);
@@ -250,9 +301,7 @@ Assembly assemble(const Json& resolved, const Registry& registry) {
                                   a.model->has_exact_nonlinear_flow()
                                       ? " (only \"direct\" in model variables does)"
                                       : " (the model has no exact nonlinear flow)"));
-  a.scheme = a.scheme_entry->create(Params(without_name(resolved["scheme"])));
-  if (resolved.contains("time") && resolved["time"].contains("h") && resolved["time"]["h"].is_number())
-    a.bind(resolved["time"]["h"].get<double>());
+  if (binds) a.bind(resolved["time"]["h"].get<double>());
   return a;
 }
 
@@ -261,8 +310,8 @@ Stepper& Assembly::bind(double h) {
   return *stepper;
 }
 
-Assembly assemble_config(const Json& config, const Registry& registry) {
-  return assemble(resolve_selection(config, registry), registry);
+Assembly assemble_config(const Json& config, const Registry& registry, const AssemblyOptions& options) {
+  return assemble(resolve_selection(config, registry), registry, options);
 }
 
 }  // namespace tsi

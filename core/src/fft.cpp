@@ -45,16 +45,19 @@ FftBatch::FftBatch(int n, int howmany, int parts) : n_(n), howmany_(howmany) {
   const bool fftw_threads = threads_ready && values >= threads_min_values && threads_setting.load() > 1;
   if (threads_ready) fftw_plan_with_nthreads(fftw_threads ? threads_setting.load() : 1);
   for (int p = 0; p <= parts; ++p) part_rows_.push_back(static_cast<int>(static_cast<long>(howmany) * p / parts));
-  buffer_ = reinterpret_cast<Complex*>(fftw_alloc_complex(static_cast<size_t>(n) * howmany));
-  if (!buffer_)
-    throw Error(fmt::format("FftBatch: cannot allocate {} x {} complex values ({:.3g} GB)", n, howmany,
-                            16.0 * static_cast<double>(values) / 1e9));
   const int signs[2] = {FFTW_FORWARD, FFTW_BACKWARD};
   bool planned = true;
   // FFTW's own threads (tsi --fft-threads) split the strided plans; otherwise large batches
   // are buffered.
   // n even: every row of a block then has the block's alignment, as fftw_execute_dft needs.
-  if (!fftw_threads && howmany >= buffered_min_rows && n >= buffered_min_points && n % 2 == 0) {
+  const bool buffered = !fftw_threads && howmany >= buffered_min_rows && n >= buffered_min_points && n % 2 == 0;
+  if (!buffered) {  // the strided plans are made on the buffer itself
+    buffer_ = reinterpret_cast<Complex*>(fftw_alloc_complex(static_cast<size_t>(n) * howmany));
+    if (!buffer_)
+      throw Error(fmt::format("FftBatch: cannot allocate {} x {} complex values ({:.3g} GB)", n, howmany,
+                              16.0 * static_cast<double>(values) / 1e9));
+  }
+  if (buffered) {
     for (int p = 0; p < parts && planned; ++p) {
       blocks_.push_back(reinterpret_cast<Complex*>(fftw_alloc_complex(static_cast<size_t>(n) * block_rows)));
       planned = blocks_.back() != nullptr;
@@ -88,7 +91,19 @@ FftBatch::FftBatch(int n, int howmany, int parts) : n_(n), howmany_(howmany) {
     release();
     throw Error(fmt::format("FftBatch: FFTW could not make a plan (or allocate a block) for {} x {}", n, howmany));
   }
-  data().setZero();
+  if (buffer_) data().setZero();
+}
+
+Complex* FftBatch::buffer() {
+  if (!buffer_) {
+    const auto count = static_cast<size_t>(n_) * static_cast<size_t>(howmany_);
+    buffer_ = reinterpret_cast<Complex*>(fftw_alloc_complex(count));
+    if (!buffer_)
+      throw Error(fmt::format("FftBatch: cannot allocate {} x {} complex values ({:.3g} GB)", n_, howmany_,
+                              16.0 * static_cast<double>(count) / 1e9));
+    std::fill(buffer_, buffer_ + count, Complex(0.0));
+  }
+  return buffer_;
 }
 
 void FftBatch::release() {
@@ -106,7 +121,53 @@ FftBatch::~FftBatch() {
   release();
 }
 
-Eigen::Map<Matrix> FftBatch::data() { return Eigen::Map<Matrix>(buffer_, howmany_, n_); }
+Eigen::Map<Matrix> FftBatch::data() { return Eigen::Map<Matrix>(buffer(), howmany_, n_); }
+
+void FftBatch::transform(const Complex* from, Complex* to, int direction, double scale, const Complex* shift,
+                         int part) {
+  const std::size_t stride = static_cast<std::size_t>(howmany_);
+  const int first = part < 0 ? 0 : part_rows_[static_cast<std::size_t>(part)];
+  const int last = part < 0 ? howmany_ : part_rows_[static_cast<std::size_t>(part) + 1];
+  if (blocks_.empty()) {  // strided: through the buffer the plans were made on
+    Eigen::Map<Matrix> buf = data();
+    const bool whole = part < 0 || part_plans_.empty();
+    const int r0 = whole ? 0 : first, rows = whole ? howmany_ : last - first;
+    auto part_rows = buf.middleRows(r0, rows);
+    if (from != buffer_) part_rows = Eigen::Map<const Matrix>(from, howmany_, n_).middleRows(r0, rows);
+    if (shift) part_rows.col(0) += Eigen::Map<const Vector>(shift, howmany_).segment(r0, rows);
+    fftw_execute(as_plan(whole ? plans_[direction] : part_plans_[2 * static_cast<std::size_t>(part) + direction]));
+    if (scale != 1.0)
+      Eigen::Map<Matrix>(to, howmany_, n_).middleRows(r0, rows) = part_rows * scale;
+    else if (to != buffer_)
+      Eigen::Map<Matrix>(to, howmany_, n_).middleRows(r0, rows) = part_rows;
+    return;
+  }
+  // Rows r .. r + k - 1 into the block, transposed (each row's n points contiguous), and back.
+  Complex* b = blocks_[part < 0 ? 0 : static_cast<std::size_t>(part)];
+  for (int r = first; r < last; r += block_rows) {
+    const int k = std::min(block_rows, last - r);
+    const Complex* in = from + r;
+    for (int j = 0; j < n_; ++j)
+      for (int i = 0; i < k; ++i) b[static_cast<std::size_t>(i) * n_ + j] = in[j * stride + i];
+    if (shift)
+      for (int i = 0; i < k; ++i) b[static_cast<std::size_t>(i) * n_] += shift[r + i];
+    if (k == block_rows) {
+      fftw_execute_dft(as_plan(block_plans_[direction]), raw(b), raw(b));
+    } else {
+      for (int i = 0; i < k; ++i) {
+        Complex* row = b + static_cast<std::size_t>(i) * n_;
+        fftw_execute_dft(as_plan(row_plans_[direction]), raw(row), raw(row));
+      }
+    }
+    Complex* out = to + r;
+    if (scale != 1.0)
+      for (int j = 0; j < n_; ++j)
+        for (int i = 0; i < k; ++i) out[j * stride + i] = b[static_cast<std::size_t>(i) * n_ + j] * scale;
+    else
+      for (int j = 0; j < n_; ++j)
+        for (int i = 0; i < k; ++i) out[j * stride + i] = b[static_cast<std::size_t>(i) * n_ + j];
+  }
+}
 
 void FftBatch::transform_rows(int first, int count, int direction, int part) {
   if (blocks_.empty()) {
@@ -116,6 +177,7 @@ void FftBatch::transform_rows(int first, int count, int direction, int part) {
   }
   // Rows r .. r + k - 1 into the block, transposed (each row's n points contiguous), and back.
   Complex* b = blocks_[part < 0 ? 0 : static_cast<std::size_t>(part)];
+  buffer();
   const std::size_t stride = static_cast<std::size_t>(howmany_);
   for (int r = first; r < first + count; r += block_rows) {
     const int k = std::min(block_rows, first + count - r);

@@ -67,6 +67,10 @@ bool FixedPointSolver::solve(Vector& x, FixedPointMap g) {
   return converged;
 }
 
+double fixed_point_state_vectors(const FixedPointOptions& options) {
+  return options.method == "anderson" ? AndersonSolver::state_vectors_for(options.anderson_depth) : 1.0;
+}
+
 std::unique_ptr<FixedPointSolver> make_fixed_point_solver(const FixedPointOptions& options) {
   if (options.method == "picard") return std::make_unique<PicardSolver>(options);
   if (options.method == "anderson") return std::make_unique<AndersonSolver>(options);

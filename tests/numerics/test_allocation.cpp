@@ -91,4 +91,23 @@ TEST_CASE("every two-scale scheme, once bound, steps without allocating (multist
   }
 }
 
+TEST_CASE("every two-scale scheme steps without allocating on a large NLS grid (coefficients per tau mode, the field in place, by slices)") {
+  // n_x = 2048, n_tau = 64: L and the coefficients one value per tau mode, the tau transforms
+  // from y into the caller's vector through their blocks, the NLS field in place 32 columns at
+  // a time.
+  auto& h = tsi::test::Harness::instance();
+  auto model = h.model_with("nls", 0.1, {{"n_x", 2048}});
+  auto two_scale = h.reformulation("two-scale", model, {{"n_tau", 64}});
+  REQUIRE(two_scale->linear_multipliers().run() == 2048);
+  for (const auto* entry : tsi::test::two_scale_schemes()) {
+    CAPTURE(entry->info.name);
+    auto stepper = h.scheme(entry->info.name, tsi::Json::object(), "nls")->bind(*two_scale, 1e-3);
+    tsi::Vector y = two_scale->prepare(model->initial_value());
+    stepper->step(0.0, y);
+    const long before = allocations.load();
+    for (int n = 1; n <= 3; ++n) stepper->step(1e-3 * n, y);
+    CHECK(allocations.load() - before == 0);
+  }
+}
+
 #endif  // !__SANITIZE_ADDRESS__

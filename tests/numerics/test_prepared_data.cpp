@@ -46,7 +46,7 @@ Derivatives time_derivatives(double eps, int order) {
   auto model = h.model("henon-heiles", eps);
   auto two_scale = h.reformulation("two-scale", model, {{"n_tau", 64}, {"initial_data_order", order}});
   const Vector u = two_scale->prepare(model->initial_value());
-  const Vector& lambda = two_scale->linear_multipliers();
+  const Vector lambda = two_scale->linear_multipliers().expanded();
   Vector n(u.size()), dn(u.size());
   two_scale->rhs(0.0, u, n);
   const Vector d1 = n;

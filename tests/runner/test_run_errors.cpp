@@ -410,13 +410,14 @@ TEST_CASE("run errors: a reference that could not finish is refused before the r
 }
 
 TEST_CASE("run errors: a run that cannot fit in memory is refused before anything is allocated") {
-  // NLS at the largest n_x with n_tau = 256: about 100 GB, far beyond a test machine.
+  // NLS at the largest n_x with n_tau = 1024: about 86 GB (5 vectors of 17 GB for SE1), far beyond a
+  // test machine.
   TempDir dir;
   const CommandResult r = run_tsi({"run", (fs::path(TSI_TEST_SOURCE_DIR) / "examples/nls-se1.json").string(), "--out",
-                                   dir / "out", "--set", "model.n_x=1048576", "--set", "reformulation.n_tau=256"});
+                                   dir / "out", "--set", "model.n_x=1048576", "--set", "reformulation.n_tau=1024"});
   INFO(r.describe());
   CHECK(r.signal == 0);
   CHECK(r.exit_code == 2);
-  CHECK(contains(r.err, "tsi: error: reformulation.n_tau: got 256: with the model's 1048576 unknowns a run needs"));
+  CHECK(contains(r.err, "tsi: error: reformulation.n_tau: got 1024: with the model's 1048576 unknowns a run needs"));
   CHECK(contains(r.err, "GB available"));
 }

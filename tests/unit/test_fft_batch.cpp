@@ -65,3 +65,40 @@ TEST_CASE("fft batch: strided and buffered batches and their parts agree with a 
     CHECK(batch.part_begin(batch.parts()) == rows);
   }
 }
+
+TEST_CASE("fft batch: transform works from and into the caller's memory, by parts, with a shift and a scale") {
+  // The same numbers as the buffer's own transforms (bit for bit), for the strided and the
+  // buffered batch, whole and by parts, and in place.
+  for (const auto& [rows, n, parts] : {std::tuple{6, 64, 1}, std::tuple{6, 64, 2}, std::tuple{37, 64, 1},
+                                       std::tuple{37, 64, 3}}) {
+    CAPTURE(rows);
+    CAPTURE(parts);
+    tsi::FftBatch reference(n, rows), batch(n, rows, parts);
+    Matrix a(rows, n);
+    for (int i = 0; i < rows; ++i)
+      for (int j = 0; j < n; ++j) a(i, j) = Complex(std::sin(0.3 * i + 0.7 * j), std::cos(1.1 * i - 0.2 * j));
+    tsi::Vector shift(rows);
+    for (int i = 0; i < rows; ++i) shift(i) = Complex(0.01 * i, -0.02 * i);
+    for (int direction = 0; direction < 2; ++direction) {
+      CAPTURE(direction);
+      // The reference: the shift added to column 0, the buffer's transform, then the scale.
+      reference.data() = a;
+      reference.data().col(0) += shift;
+      if (direction == 0)
+        reference.forward_unnormalised();
+      else
+        reference.backward();
+      const Matrix expected = reference.data() * (1.0 / n);
+      Matrix out(rows, n);
+      if (parts == 1) {
+        batch.transform(a.data(), out.data(), direction, 1.0 / n, shift.data());
+      } else {
+        for (int p = 0; p < parts; ++p) batch.transform(a.data(), out.data(), direction, 1.0 / n, shift.data(), p);
+      }
+      CHECK(out == expected);
+      Matrix in_place = a;
+      batch.transform(in_place.data(), in_place.data(), direction, 1.0 / n, shift.data());
+      CHECK(in_place == expected);
+    }
+  }
+}

@@ -1,8 +1,10 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <span>
 
+#include "tsi/diagonal.hpp"
 #include "tsi/types.hpp"
 
 /// The vector arithmetic of the schemes and fixed-point solvers, in one place (as
@@ -73,6 +75,116 @@ inline void diagonal_linear_combination(const Vector* start, std::span<const Vec
       acc.setZero();
     for (size_t j = 0; j < x.size(); ++j) acc += d[j]->segment(b, m).cwiseProduct(x[j]->segment(b, m));
     out.segment(b, m) = acc;
+  }
+}
+
+/// The same operations with a Diagonal (stored once per run of equal entries: the two-scale
+/// coefficients, n_tau values instead of dim x n_tau): the same products entry by entry, a run
+/// at a time (diagonals of different runs go entry by entry).
+namespace detail {
+/// The run all of ds share, or 0 when they differ.
+inline Index common_run(std::initializer_list<const Diagonal*> ds) {
+  Index run = (*ds.begin())->run();
+  for (const Diagonal* d : ds)
+    if (d->run() != run) return 0;
+  return run;
+}
+}  // namespace detail
+
+/// out = d . x (out may alias x).
+inline void diagonal_multiply(const Diagonal& d, const Vector& x, Vector& out) {
+  out.resize(x.size());
+  const Index r = d.run();
+  const Vector& v = d.values();
+  if (r == 1) {
+    out = v.cwiseProduct(x);
+    return;
+  }
+  for (Index b = 0; b < v.size(); ++b) out.segment(b * r, r) = v(b) * x.segment(b * r, r);
+}
+
+/// out = x + d . y (out may alias x or y).
+inline void diagonal_multiply_add(const Vector& x, const Diagonal& d, const Vector& y, Vector& out) {
+  out.resize(x.size());
+  const Index r = d.run();
+  const Vector& v = d.values();
+  if (r == 1) {
+    out = x + v.cwiseProduct(y);
+    return;
+  }
+  for (Index b = 0; b < v.size(); ++b) out.segment(b * r, r) = x.segment(b * r, r) + v(b) * y.segment(b * r, r);
+}
+
+/// out = d1 . x1 + d2 . x2 (out may alias x1 or x2).
+inline void diagonal_combination(const Diagonal& d1, const Vector& x1, const Diagonal& d2, const Vector& x2,
+                                 Vector& out) {
+  out.resize(x1.size());
+  const Index r = detail::common_run({&d1, &d2});
+  const Vector &v1 = d1.values(), &v2 = d2.values();
+  if (r == 1) {
+    out = v1.cwiseProduct(x1) + v2.cwiseProduct(x2);
+  } else if (r > 1) {
+    for (Index b = 0; b < v1.size(); ++b)
+      out.segment(b * r, r) = v1(b) * x1.segment(b * r, r) + v2(b) * x2.segment(b * r, r);
+  } else {
+    for (Index i = 0; i < x1.size(); ++i) out(i) = d1(i) * x1(i) + d2(i) * x2(i);
+  }
+}
+
+/// out = d1 . x1 + d2 . x2 + d3 . x3 (out may alias any x).
+inline void diagonal_combination(const Diagonal& d1, const Vector& x1, const Diagonal& d2, const Vector& x2,
+                                 const Diagonal& d3, const Vector& x3, Vector& out) {
+  out.resize(x1.size());
+  const Index r = detail::common_run({&d1, &d2, &d3});
+  const Vector &v1 = d1.values(), &v2 = d2.values(), &v3 = d3.values();
+  if (r == 1) {
+    out = v1.cwiseProduct(x1) + v2.cwiseProduct(x2) + v3.cwiseProduct(x3);
+  } else if (r > 1) {
+    for (Index b = 0; b < v1.size(); ++b)
+      out.segment(b * r, r) =
+          v1(b) * x1.segment(b * r, r) + v2(b) * x2.segment(b * r, r) + v3(b) * x3.segment(b * r, r);
+  } else {
+    for (Index i = 0; i < x1.size(); ++i) out(i) = d1(i) * x1(i) + d2(i) * x2(i) + d3(i) * x3(i);
+  }
+}
+
+/// out = start + sum_j d_j . x_j over k pairs (start may be null: none), in one pass over memory,
+/// the terms accumulated in the order given, as above (out may alias start or any x_j).
+inline void diagonal_linear_combination(const Vector* start, std::span<const Diagonal* const> d,
+                                        std::span<const Vector* const> x, Vector& out) {
+  const Index n = start ? start->size() : x.front()->size();
+  out.resize(n);
+  Index r = d.empty() ? 1 : d.front()->run();
+  for (const Diagonal* dj : d)
+    if (dj->run() != r) r = 0;
+  if (r == 0) {  // runs that differ: entry by entry
+    for (Index i = 0; i < n; ++i) {
+      Complex acc = start ? (*start)(i) : Complex(0.0);
+      for (size_t j = 0; j < x.size(); ++j) acc += (*d[j])(i) * (*x[j])(i);
+      out(i) = acc;
+    }
+    return;
+  }
+  constexpr Index block = 256;
+  Eigen::Matrix<Complex, block, 1> sum;
+  // Blocks of at most `block` entries inside one run: every coefficient is one value there
+  // (r = 1: a segment of each diagonal).
+  for (Index b = 0; b < n;) {
+    const Index run_end = r == 1 ? n : (b / r + 1) * r;
+    const Index m = std::min(block, run_end - b);
+    auto acc = sum.head(m);
+    if (start)
+      acc = start->segment(b, m);
+    else
+      acc.setZero();
+    if (r == 1) {
+      for (size_t j = 0; j < x.size(); ++j) acc += d[j]->values().segment(b, m).cwiseProduct(x[j]->segment(b, m));
+    } else {
+      const Index v = b / r;
+      for (size_t j = 0; j < x.size(); ++j) acc += d[j]->values()(v) * x[j]->segment(b, m);
+    }
+    out.segment(b, m) = acc;
+    b += m;
   }
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 #include <memory>
+#include <string>
 
 #include "tsi/export.hpp"
 #include "tsi/params.hpp"
@@ -16,6 +17,37 @@ namespace tsi {
 /// field. Returns {"model": {...}, "reformulation": {...}, "scheme": {...}}, each with "name".
 TSI_API Json resolve_selection(const Json& config, const Registry& registry);
 
+/// The memory a two-scale run of a selection holds at its peak, in vectors of the state's size
+/// (dim x n_tau complex values), known before anything of that size is allocated: the state, the
+/// bound scheme's vectors (Scheme::state_vectors for the problem's layout), the two-scale
+/// problem's work space and its prepared data's temporaries (TwoScale::work_vectors). All zero
+/// for the other reformulations.
+struct TSI_API Footprint {
+  double dim = 0.0, n_tau = 0.0;
+  double state_bytes = 0.0;          ///< 16 dim n_tau
+  std::string scheme;                ///< the scheme's name
+  double scheme_vectors = 0.0;       ///< the bound scheme's
+  double problem_vectors = 0.0;      ///< the two-scale problem's work space (an allowance for the model's grid)
+  double preparation_vectors = 0.0;  ///< the prepared data's temporaries (freed before the steps)
+  double vectors = 0.0;              ///< at the peak, the state included
+  double bytes() const { return vectors * state_bytes; }
+};
+
+/// How assemble builds a run.
+struct TSI_API AssemblyOptions {
+  /// Bind the scheme to time.h when the config has it. A run binds after it has prepared its
+  /// data (false here, then Assembly::bind): the preparation's temporaries are freed by then.
+  bool bind = true;
+  /// The memory a two-scale run may take, in bytes (0: what the machine has available now);
+  /// a run whose footprint exceeds it is refused, naming its sizes, before it is built.
+  double memory_bytes = 0.0;
+};
+
+/// The footprint of a two-scale run of `model` with these resolved reformulation parameters
+/// and this scheme (bound before or after the preparation of the data).
+TSI_API Footprint two_scale_footprint(const Model& model, const Json& reformulation, const Scheme& scheme,
+                                      const std::string& scheme_name, bool bound_before_preparation);
+
 /// The objects of a run, built from a resolved selection.
 struct TSI_API Assembly {
   const ModelEntry* model_entry = nullptr;
@@ -28,19 +60,22 @@ struct TSI_API Assembly {
   /// The scheme bound to the reformulation: by assemble when the config has time.h, else by bind.
   std::unique_ptr<Stepper> stepper;
   Vector u0;  ///< the initial value in model variables (model.u0 in physical variables, or the model's own)
+  Footprint footprint;  ///< what the run will hold at its peak (checked before the reformulation was built)
 
   /// Binds the scheme to the reformulation and step size h (replacing any earlier binding).
   Stepper& bind(double h);
 };
 
-/// Builds model, reformulation and scheme from a resolved selection (resolve_selection) and
+/// Builds model, scheme and reformulation from a resolved selection (resolve_selection) and
 /// enforces the declared capabilities before anything runs: a scheme that needs a diagonal
 /// linear part or exact flows on a problem without them is a ConfigError naming scheme,
-/// model and reformulation.
-TSI_API Assembly assemble(const Json& resolved, const Registry& registry);
+/// model and reformulation; a two-scale run whose footprint exceeds the memory available
+/// (options.memory_bytes) is a ConfigError on reformulation.n_tau naming its sizes, raised before
+/// the reformulation is built.
+TSI_API Assembly assemble(const Json& resolved, const Registry& registry, const AssemblyOptions& options = {});
 
 /// resolve_selection then assemble.
-TSI_API Assembly assemble_config(const Json& config, const Registry& registry);
+TSI_API Assembly assemble_config(const Json& config, const Registry& registry, const AssemblyOptions& options = {});
 
 /// The initial value a model section asks for, in model variables: its "u0" (physical
 /// variables: numbers, or [re, im] pairs for a complex model; or the name of a .npy file of

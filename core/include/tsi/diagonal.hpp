@@ -1,12 +1,64 @@
 #pragma once
 #include <span>
+#include <utility>
+#include <vector>
 
 #include "tsi/types.hpp"
 
 namespace tsi {
 
+/// The diagonal of an operator on a problem's unknowns, stored once per run of equal entries:
+/// entry i is values()(i / run()). The two-scale L without a remainder is constant on the dim
+/// unknowns of each tau mode, so it and its functions (e^{hL}, h phi1(hL), the weights of a
+/// multistep or collocation scheme) hold n_tau values instead of dim x n_tau; with run() = 1
+/// every entry is stored. tsi::algebra's diagonal operations take it as they take a Vector.
+class Diagonal {
+ public:
+  Diagonal() = default;
+  /// Entry i is values(i / run).
+  explicit Diagonal(Vector values, Index run = 1) : values_(std::move(values)), run_(run < 1 ? 1 : run) {}
+
+  /// Entries (unknowns) it acts on.
+  Index size() const { return values_.size() * run_; }
+  /// Consecutive entries that share one stored value.
+  Index run() const { return run_; }
+  /// The stored values, one per run.
+  const Vector& values() const { return values_; }
+  /// Entry i.
+  Complex operator()(Index i) const { return values_(i / run_); }
+  /// Every entry, one per unknown (a Vector of size()).
+  Vector expanded() const {
+    Vector out(size());
+    for (Index b = 0; b < values_.size(); ++b) out.segment(b * run_, run_).setConstant(values_(b));
+    return out;
+  }
+  /// Its memory in vectors of its size (1 / run()).
+  double state_fraction() const { return size() ? static_cast<double>(values_.size()) / static_cast<double>(size()) : 0.0; }
+
+ private:
+  Vector values_;
+  Index run_ = 1;
+};
+
 /// out_i = f(scale * lambda_i): a function of the diagonal operator scale * L, evaluated
-/// once per step size by the exponential schemes (e^{hL}, h phi1(hL), ...).
+/// once per step size by the exponential schemes (e^{hL}, h phi1(hL), ...), once per stored value.
+template <class F>
+void diagonal_function(const Diagonal& lambda, double scale, F&& f, Diagonal& out) {
+  const Vector& v = lambda.values();
+  Vector values(v.size());
+  for (Index i = 0; i < v.size(); ++i) values(i) = f(scale * v(i));
+  out = Diagonal(std::move(values), lambda.run());
+}
+
+/// The same with one value per unknown (a coefficient a scheme stores as a Vector).
+template <class F>
+void diagonal_function(const Diagonal& lambda, double scale, F&& f, Vector& out) {
+  Diagonal d;
+  diagonal_function(lambda, scale, std::forward<F>(f), d);
+  out = d.expanded();
+}
+
+/// out_i = f(scale * lambda_i) for a Vector of the diagonal's entries.
 template <class F>
 void diagonal_function(const Vector& lambda, double scale, F&& f, Vector& out) {
   out.resize(lambda.size());
@@ -14,7 +66,19 @@ void diagonal_function(const Vector& lambda, double scale, F&& f, Vector& out) {
 }
 
 /// outs[j]_i = f(scale * lambda_i)[j] for a function with several values per point (the
-/// weights of an exponential multistep or collocation scheme), each out sized like lambda.
+/// weights of an exponential multistep or collocation scheme), each out shaped like lambda.
+template <class F>
+void diagonal_functions(const Diagonal& lambda, double scale, F&& f, std::span<Diagonal* const> outs) {
+  const Vector& v = lambda.values();
+  std::vector<Vector> values(outs.size(), Vector(v.size()));
+  for (Index i = 0; i < v.size(); ++i) {
+    const auto w = f(scale * v(i));
+    for (size_t j = 0; j < outs.size(); ++j) values[j](i) = w[j];
+  }
+  for (size_t j = 0; j < outs.size(); ++j) *outs[j] = Diagonal(std::move(values[j]), lambda.run());
+}
+
+/// The same for a Vector of the diagonal's entries, each out sized like lambda.
 template <class F>
 void diagonal_functions(const Vector& lambda, double scale, F&& f, std::span<Vector* const> outs) {
   for (Vector* out : outs) out->resize(lambda.size());

@@ -23,7 +23,8 @@ TSI_API void set_fft_threads(int threads, long min_values = 65536);
 /// buffer, a few rows at a time: FFTW_ESTIMATE's plan for the strided batch walks the whole
 /// buffer once per transform (2.7 ms for 256 x 256 here), the buffered one stays in cache
 /// (0.32 ms), and unlike FFTW_MEASURE it is the same plan in every process, so results do
-/// not depend on timings.
+/// not depend on timings. A buffered batch allocates its howmany x n buffer only when data() is
+/// first called: transform() works on the caller's memory through the blocks alone.
 class TSI_API FftBatch {
  public:
   FftBatch(int n, int howmany, int parts = 1);
@@ -31,8 +32,16 @@ class TSI_API FftBatch {
   FftBatch(const FftBatch&) = delete;
   FftBatch& operator=(const FftBatch&) = delete;
 
-  /// The work buffer, howmany x n.
+  /// The work buffer, howmany x n (a buffered batch allocates it here, on the first call).
   Eigen::Map<Matrix> data();
+  /// Transforms howmany x n values at `from` into `to` (the buffer's layout; `to` may be `from`)
+  /// without the batch's buffer where it is buffered: forward (direction 0, unnormalised) or
+  /// backward (1), with `shift` (howmany values, or null) added to column 0 on the way in and
+  /// every result multiplied by `scale` on the way out (the same products as a pass after).
+  /// With `part` (0 <= part < parts()) only that part's rows, through its own block: parts may
+  /// be transformed at the same time on different threads.
+  void transform(const Complex* from, Complex* to, int direction, double scale = 1.0, const Complex* shift = nullptr,
+                 int part = -1);
   /// Values at tau_j = 2*pi*j/n -> Fourier coefficients (normalised by 1/n).
   void forward();
   /// The same without the 1/n: for callers that fold the normalisation into their next pass.
@@ -55,6 +64,8 @@ class TSI_API FftBatch {
   /// Transforms rows [first, first + count) of the buffer (direction 0 forward, 1 backward)
   /// for part `part` (-1: the whole batch): strided, or through that part's block.
   void transform_rows(int first, int count, int direction, int part);
+  /// The buffer, allocated (and zeroed) on first use.
+  Complex* buffer();
   void release();
 
   int n_, howmany_;

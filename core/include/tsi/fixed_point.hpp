@@ -73,6 +73,10 @@ class TSI_API StageGuess {
   bool have_previous_ = false;
 };
 
+/// The work vectors of the iterate's size the solver the options ask for keeps
+/// (FixedPointSolver::state_vectors, known before it is made).
+TSI_API double fixed_point_state_vectors(const FixedPointOptions& options);
+
 /// The solver the options ask for (Picard or Anderson).
 TSI_API std::unique_ptr<FixedPointSolver> make_fixed_point_solver(const FixedPointOptions& options);
 

@@ -15,7 +15,7 @@ namespace tsi {
 /// backward(forward(a)) = n a; index k >= n/2 holds the wave number k - n.
 class GridFft {
  public:
-  GridFft(int n, Index columns) : fft_(n, static_cast<int>(columns)), scratch_(columns, n) {}
+  GridFft(int n, Index columns) : fft_(n, static_cast<int>(columns)), n_(n), columns_(columns) {}
 
   /// columns x n: row j is state j (grid samples or Fourier coefficients).
   Eigen::Map<Matrix> data() { return fft_.data(); }
@@ -23,11 +23,18 @@ class GridFft {
   void forward() { fft_.forward_unnormalised(); }
   /// Unnormalised: sum_k a_k e^{+2 pi i j k / n}.
   void backward() { fft_.backward(); }
-  /// Work space of the same shape (a second grid, as a derivative needs).
-  Matrix& scratch() { return scratch_; }
+  /// Work space of the same shape (a second grid, as a derivative needs), allocated on first use.
+  Matrix& scratch() {
+    if (scratch_.size() == 0) scratch_.resize(columns_, n_);
+    return scratch_;
+  }
+  /// Columns (states) it transforms at once.
+  Index columns() const { return columns_; }
 
  private:
   FftBatch fft_;
+  int n_;
+  Index columns_;
   Matrix scratch_;
 };
 

@@ -25,6 +25,10 @@ class TSI_API TauGridField {
   virtual bool evaluates_real() const { return false; }
   /// evaluate on real grid values (real models that declare evaluates_real; the default throws).
   virtual void evaluate_real(RealMatrixRef states, RealMatrixRef out);
+  /// True when evaluate(states, out) (and evaluate_real) may be called with out and states the
+  /// same matrix (each column read before it is written): the two-scale problem then evaluates
+  /// in the caller's vector and holds no grid buffer of its own.
+  virtual bool in_place() const { return false; }
 };
 
 /// A quantity a model declares as conserved (or nearly) besides H, I and m: runs record its

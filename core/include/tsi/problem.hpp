@@ -1,13 +1,27 @@
 #pragma once
+#include "tsi/diagonal.hpp"
 #include "tsi/export.hpp"
 #include "tsi/types.hpp"
 
 namespace tsi {
 
+/// What the memory of a binding depends on, known before the problem is built: a scheme's
+/// vectors of the state's size (Scheme::state_vectors) follow from it.
+struct TSI_API ProblemLayout {
+  Index size = 0;             ///< unknowns (complex values of the state)
+  Index diagonal_values = 0;  ///< values one diagonal coefficient stores (Diagonal::values)
+  /// A diagonal coefficient's memory in vectors of the state's size.
+  double diagonal_fraction() const {
+    return size > 0 ? static_cast<double>(diagonal_values) / static_cast<double>(size) : 1.0;
+  }
+};
+
 /// The problem a stepper integrates:  y' = L y + N(t, y).
 /// L is diagonal in the problem's coordinates when linear_multipliers() has one entry per
 /// unknown (two-scale: -i k / eps per tau-Fourier mode; filtered: all zero); it is empty
-/// when L is not diagonal (direct), and then only rhs() is available.
+/// when L is not diagonal (direct), and then only rhs() is available. It is a tsi::Diagonal:
+/// the two-scale L without a remainder is stored once per tau mode, and so are the
+/// coefficients a scheme computes from it (tsi::diagonal_function).
 class TSI_API Problem {
  public:
   virtual ~Problem() = default;
@@ -17,8 +31,13 @@ class TSI_API Problem {
   /// A zero state of this problem's layout: the prototype steppers allocate their
   /// coefficients and work space from (a device backend allocates on the device here).
   Vector new_state() const { return Vector::Zero(size()); }
-  /// The diagonal of L, or an empty vector when L is not diagonal in these coordinates.
-  virtual const Vector& linear_multipliers() const = 0;
+  /// The diagonal of L, or an empty one when L is not diagonal in these coordinates.
+  virtual const Diagonal& linear_multipliers() const = 0;
+  /// Its size and the values a diagonal coefficient stores (for the memory of a binding).
+  ProblemLayout layout() const {
+    const Diagonal& d = linear_multipliers();
+    return {size(), d.size() == size() ? d.values().size() : size()};
+  }
   bool has_diagonal_linear_part() const { return linear_multipliers().size() == size(); }
   /// The part of linear_multipliers() that is the model's remainder J R (i omega_j on every
   /// unknown of model coordinate j), or empty without one. A scheme that approximates e^{hL}

@@ -1,5 +1,6 @@
 #pragma once
 #include <algorithm>
+#include <concepts>
 #include <memory>
 #include <string>
 #include <utility>
@@ -83,17 +84,31 @@ class TSI_API Stepper {
 /// length, from one Scheme.
 class TSI_API Scheme {
  public:
+  /// What state_vectors(layout) answers for a scheme that does not say: an allowance.
+  static constexpr double unknown_state_vectors = 16.0;
+
   virtual ~Scheme() = default;
   virtual std::unique_ptr<Stepper> bind(Problem& problem, double h) const = 0;
+  /// The vectors of the state's size a binding to a problem of this layout will hold (what its
+  /// Stepper's state_vectors() reports), known before the problem is built or anything of its
+  /// size allocated: a run's footprint check uses it.
+  virtual double state_vectors(const ProblemLayout& /*layout*/) const { return unknown_state_vectors; }
 };
 
-/// The common scheme: its steppers are Bound(problem, h, settings).
+/// The common scheme: its steppers are Bound(problem, h, settings), and their memory is
+/// Bound::state_vectors_for(layout, settings) where Bound declares it (static).
 template <class Bound, class Settings>
 class BindingScheme final : public Scheme {
  public:
   explicit BindingScheme(Settings settings) : settings_(std::move(settings)) {}
   std::unique_ptr<Stepper> bind(Problem& problem, double h) const override {
     return std::make_unique<Bound>(problem, h, settings_);
+  }
+  double state_vectors(const ProblemLayout& layout) const override {
+    if constexpr (requires { { Bound::state_vectors_for(layout, settings_) } -> std::convertible_to<double>; })
+      return Bound::state_vectors_for(layout, settings_);
+    else
+      return Scheme::state_vectors(layout);
   }
 
  private:

@@ -19,7 +19,7 @@ class Direct final : public Reformulation {
   explicit Direct(std::shared_ptr<const Model> model, Variables variables = Variables::model);
 
   Index size() const override { return size_; }
-  const Vector& linear_multipliers() const override { return none_; }
+  const Diagonal& linear_multipliers() const override { return none_; }
   void nonlinear(double t, const Vector& y, Vector& out) override;
   void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
   void rhs(double t, const Vector& y, Vector& out) override;
@@ -45,7 +45,7 @@ class Direct final : public Reformulation {
 
   bool physical_;
   Index size_;
-  Vector none_;
+  Diagonal none_;
   Matrix state_, direction_, field_;
   Vector mu_, au_;  // M u and A u
   Vector remainder_;  // i omega per coordinate (empty without a remainder)

@@ -15,6 +15,7 @@ Filtered::Filtered(std::shared_ptr<const Model> model)
       direction_(model_->dim(), 1),
       field_(model_->dim(), 1) {
   if (!has_remainder_) multipliers_ = Vector::Zero(model_->dim());
+  diagonal_ = Diagonal(multipliers_);
 }
 
 void Filtered::rhs(double t, const Vector& y, Vector& out) {

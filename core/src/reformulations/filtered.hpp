@@ -12,7 +12,7 @@ class Filtered final : public Reformulation {
   explicit Filtered(std::shared_ptr<const Model> model);
 
   Index size() const override { return model_->dim(); }
-  const Vector& linear_multipliers() const override { return multipliers_; }
+  const Diagonal& linear_multipliers() const override { return diagonal_; }
   const Vector& remainder_multipliers() const override { return has_remainder_ ? multipliers_ : none_; }
   /// The shortest period of the explicit time dependence: 2 pi eps over the model's
   /// largest linear frequency (2 pi eps for Henon-Heiles; 2 pi eps / 64 for NLS with N_x = 16).
@@ -27,6 +27,7 @@ class Filtered final : public Reformulation {
  private:
   Vector multipliers_;  // i omega of the remainder, or zeros
   bool has_remainder_;
+  Diagonal diagonal_;  // multipliers_ as L's diagonal
   Vector none_;
   RealVector tau_, minus_tau_;  // one phase and its negative, reused
   Matrix state_, direction_, field_;

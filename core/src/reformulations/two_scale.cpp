@@ -12,6 +12,7 @@
 
 #include "remainder.hpp"
 #include "sigma_nodes.hpp"
+#include "tsi/algebra.hpp"
 #include "tsi/error.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/tau_grid_threads.hpp"
@@ -72,9 +73,7 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
     : Reformulation(std::move(model)),
       dim_(model_->dim()),
       n_tau_(n_tau),
-      // A remainder turns coordinates by complex phases: its U is complex (a real model has none).
-      real_layout_(real_layout && !model_->is_complex() && !model_->has_linear_remainder() && n_tau > 0 &&
-                   n_tau % 2 == 0),
+      real_layout_(real_layout && real_layout_for(*model_) && n_tau > 0 && n_tau % 2 == 0),
       columns_(real_layout_ ? n_tau / 2 + 1 : n_tau),
       data_order_(initial_data_order),
       data_method_(data_method),
@@ -92,34 +91,72 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
                                                               ", expected an integer from 1 to " +
                                                               std::to_string(max_data_order));
   if (remainder_.size()) remainder_grid_ = remainder_.replicate(columns_, 1);
-  multipliers_.resize(size());
+  const Index run = remainder_.size() ? 1 : diagonal_run(*model_);
+  Vector multipliers(run == 1 ? dim_ * columns_ : columns_);
   for (int j = 0; j < n_tau; ++j) {
     taus_(j) = two_pi * j / n_tau;
     wave_numbers_(j) = j <= n_tau / 2 ? j : j - n_tau;
-    if (j >= columns_) continue;
+    if (j >= columns_) continue;  // the real layout stores modes 0 .. n/2
     // Nyquist: -i k / eps is 0 there, as the Fourier differentiation matrix has it.
     const double k = (2 * j == n_tau) ? 0.0 : wave_numbers_(j);
-    multipliers_.segment(j * dim_, dim_).setConstant(Complex(0.0, -k / eps_));
-    if (remainder_.size()) multipliers_.segment(j * dim_, dim_) += remainder_;
+    if (run > 1) {
+      multipliers(j) = Complex(0.0, -k / eps_);
+      continue;
+    }
+    multipliers.segment(j * dim_, dim_).setConstant(Complex(0.0, -k / eps_));
+    if (remainder_.size()) multipliers.segment(j * dim_, dim_) += remainder_;
   }
+  multipliers_ = Diagonal(std::move(multipliers), run);
   const int rows = static_cast<int>(dim_);
   if (real_layout_) {
     real_fft_ = std::make_unique<RealFftBatch>(n_tau, rows, threads_);
     grid_values_.setZero(dim_, n_tau);
-    field_values_.setZero(dim_, n_tau);
   } else {
     fft_ = std::make_unique<FftBatch>(n_tau, rows, threads_);
-    field_fft_ = std::make_unique<FftBatch>(n_tau, rows, threads_);
   }
   grid_field_ = model_->bind_tau_grid(taus_);
-  real_kernels_ = real_layout_ && grid_field_->evaluates_real();
-  if (real_layout_ && !real_kernels_) {
-    complex_grid_.setZero(dim_, n_tau);
-    complex_field_.setZero(dim_, n_tau);
-  }
   for (int p = 0; p <= threads_; ++p) column_begin_.push_back(static_cast<Index>(n_tau) * p / threads_);
   for (int p = 0; threads_ > 1 && p < threads_; ++p)
     column_fields_.push_back(model_->bind_tau_grid(taus_.segment(column_begin_[p], column_begin_[p + 1] - column_begin_[p])));
+  if (real_layout_) {
+    real_kernels_ = grid_field_->evaluates_real();
+    for (const auto& f : column_fields_) real_kernels_ = real_kernels_ && f->evaluates_real();
+    bool in_place = real_kernels_ && grid_field_->in_place();
+    for (const auto& f : column_fields_) in_place = in_place && f->in_place();
+    if (!in_place) field_values_.setZero(dim_, n_tau);
+    if (!real_kernels_) {
+      complex_grid_.setZero(dim_, n_tau);
+      complex_field_.setZero(dim_, n_tau);
+    }
+  }
+}
+
+bool TwoScale::real_layout_for(const Model& model) {
+  // A remainder turns coordinates by complex phases: its U is complex (a real model has none).
+  return !model.is_complex() && !model.has_linear_remainder();
+}
+
+Index TwoScale::diagonal_run(const Model& model) {
+  return model_remainder(model).size() == 0 && model.dim() >= min_diagonal_run ? model.dim() : 1;
+}
+
+double TwoScale::work_vectors(const Model& model, int initial_data_order, const std::string& data_method,
+                              double* preparation) {
+  // The closed formulas (orders 2, 3) hold at most 4 grids at once (r2), the central quotients
+  // a grid per level of their recursion and its quotient's four, the recursion along a
+  // trajectory the previous and the next level at its m points (trajectory_data).
+  const bool remainder = model_remainder(model).size() > 0;
+  double prepare = 2.0;
+  if (initial_data_order >= 2) {
+    if (data_method == "central")
+      prepare = 3.0 + 2.0 * initial_data_order;
+    else if (data_method == "recursion" || initial_data_order > 3)
+      prepare = 2.0 * trajectory_point_count(initial_data_order, remainder) + 3.0;
+    else
+      prepare = initial_data_order == 3 ? 5.0 : 2.0;
+  }
+  if (preparation) *preparation = prepare;
+  return 1.0 + (remainder ? 2.0 : 0.0) + prepare;
 }
 
 void TwoScale::nonlinear(double /*t*/, const Vector& y, Vector& out) { nonlinear_shifted(y, nullptr, out); }
@@ -128,27 +165,36 @@ void TwoScale::nonlinear_shifted(const Vector& y, const Vector* mean_shift, Vect
   ++evaluations_;
   if (real_layout_) return nonlinear_real(y, mean_shift, out);
   if (threads_ > 1) return nonlinear_threaded(y, mean_shift, out);
-  auto grid = fft_->data();
-  auto field = field_fft_->data();
-  grid = Eigen::Map<const Matrix>(y.data(), dim_, n_tau_);
-  if (mean_shift) grid.col(0) += *mean_shift;
-  fft_->backward();
-  grid_field_->evaluate(grid, field);
-  field_fft_->forward_unnormalised();
+  // The grid in out's storage: the tau transforms go through their small blocks, and a model
+  // that evaluates in place needs no grid of the state's size besides out.
   out.resize(size());
-  Eigen::Map<Matrix>(out.data(), dim_, n_tau_) = field * (1.0 / n_tau_);  // the 1/n of the transform
+  fft_->transform(y.data(), out.data(), 1, 1.0, mean_shift ? mean_shift->data() : nullptr);
+  Eigen::Map<Matrix> grid(out.data(), dim_, n_tau_);
+  Complex* field = out.data();
+  if (grid_field_->in_place()) {
+    grid_field_->evaluate(grid, grid);
+  } else {
+    field_.resize(dim_, n_tau_);
+    grid_field_->evaluate(grid, field_);
+    field = field_.data();
+  }
+  fft_->transform(field, out.data(), 0, 1.0 / n_tau_);  // the 1/n of the transform
 }
 
 void TwoScale::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out) {
+  // As the serial path: the grid in out's storage, each thread's rows transformed through its
+  // own block, the field in place where the model allows it.
   out.resize(size());
-  auto grid = fft_->data();
-  auto field = field_fft_->data();
-  const Eigen::Map<const Matrix> coefficients(y.data(), dim_, n_tau_);
-  Eigen::Map<Matrix> result(out.data(), dim_, n_tau_);
+  const bool in_place = std::all_of(column_fields_.begin(), column_fields_.end(),
+                                    [](const std::unique_ptr<TauGridField>& f) { return f->in_place(); });
+  if (!in_place) field_.resize(dim_, n_tau_);
+  Eigen::Map<Matrix> grid(out.data(), dim_, n_tau_);
+  Complex* field = in_place ? out.data() : field_.data();
+  const Complex* shift = mean_shift ? mean_shift->data() : nullptr;
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads_));
-  // Copies go by columns (contiguous), transforms by rows; every phase reads what the one
-  // before wrote on other threads, hence the barriers. A team smaller than asked for (an
-  // OpenMP limit) takes several parts per thread.
+  // Transforms go by rows, the field by columns; every phase reads what the one before wrote
+  // on other threads, hence the barriers. A team smaller than asked for (an OpenMP limit)
+  // takes several parts per thread.
 #if defined(_OPENMP)
 #pragma omp parallel num_threads(threads_)
 #endif
@@ -156,24 +202,20 @@ void TwoScale::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vec
     const auto parts = [&](auto&& work) {
       for (int p = thread_index(); p < threads_; p += team_size()) work(p, column_begin_[p], column_begin_[p + 1] - column_begin_[p]);
     };
-    parts([&](int, Index c0, Index cn) {
-      grid.middleCols(c0, cn) = coefficients.middleCols(c0, cn);
-      if (mean_shift && c0 == 0 && cn > 0) grid.col(0) += *mean_shift;
-    });
-    barrier();
-    parts([&](int p, Index, Index) { fft_->backward_part(p); });
+    parts([&](int p, Index, Index) { fft_->transform(y.data(), out.data(), 1, 1.0, shift, p); });
     barrier();
     parts([&](int p, Index c0, Index cn) {
       try {
-        column_fields_[p]->evaluate(grid.middleCols(c0, cn), field.middleCols(c0, cn));
+        if (in_place)
+          column_fields_[p]->evaluate(grid.middleCols(c0, cn), grid.middleCols(c0, cn));
+        else
+          column_fields_[p]->evaluate(grid.middleCols(c0, cn), field_.middleCols(c0, cn));
       } catch (...) {
         errors[p] = std::current_exception();
       }
     });
     barrier();
-    parts([&](int p, Index, Index) { field_fft_->forward_part(p); });
-    barrier();
-    parts([&](int, Index c0, Index cn) { result.middleCols(c0, cn) = field.middleCols(c0, cn) * (1.0 / n_tau_); });
+    parts([&](int p, Index, Index) { fft_->transform(field, out.data(), 0, 1.0 / n_tau_, nullptr, p); });
   }
   for (const auto& error : errors)
     if (error) std::rethrow_exception(error);
@@ -181,6 +223,8 @@ void TwoScale::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vec
 
 void TwoScale::nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& out) {
   out.resize(size());
+  const bool in_place = field_values_.size() == 0;
+  const double* field = in_place ? grid_values_.data() : field_values_.data();
   const auto transform_in = [&](int part) {
     // The mean shift is a constant in tau: added to the grid values, as to the mean mode.
     real_fft_->backward(y.data(), grid_values_.data(), part);
@@ -193,7 +237,7 @@ void TwoScale::nonlinear_real(const Vector& y, const Vector* mean_shift, Vector&
   if (threads_ <= 1) {
     transform_in(-1);
     evaluate_real_grid(*grid_field_, 0, n_tau_);
-    real_fft_->forward_unnormalised(field_values_.data(), out.data());
+    real_fft_->forward_unnormalised(field, out.data());
     out *= scale;
     return;
   }
@@ -217,7 +261,7 @@ void TwoScale::nonlinear_real(const Vector& y, const Vector* mean_shift, Vector&
     });
     barrier();
     parts([&](int p, Index, Index) {
-      real_fft_->forward_unnormalised(field_values_.data(), out.data(), p);
+      real_fft_->forward_unnormalised(field, out.data(), p);
       const Index r0 = real_fft_->part_begin(p), rn = real_fft_->part_begin(p + 1) - r0;
       Eigen::Map<Matrix>(out.data(), dim_, columns_).middleRows(r0, rn) *= scale;
     });
@@ -227,22 +271,25 @@ void TwoScale::nonlinear_real(const Vector& y, const Vector* mean_shift, Vector&
 }
 
 void TwoScale::evaluate_real_grid(TauGridField& field, Index c0, Index cn) {
-  if (real_kernels_) return field.evaluate_real(grid_values_.middleCols(c0, cn), field_values_.middleCols(c0, cn));
-  complex_grid_.middleCols(c0, cn) = grid_values_.middleCols(c0, cn).cast<Complex>();
+  auto values = grid_values_.middleCols(c0, cn);
+  if (real_kernels_) {
+    if (field_values_.size() == 0) return field.evaluate_real(values, values);
+    return field.evaluate_real(values, field_values_.middleCols(c0, cn));
+  }
+  complex_grid_.middleCols(c0, cn) = values.cast<Complex>();
   field.evaluate(complex_grid_.middleCols(c0, cn), complex_field_.middleCols(c0, cn));
   field_values_.middleCols(c0, cn) = complex_field_.middleCols(c0, cn).real();
 }
 
 void TwoScale::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& dy, Vector& out) {
-  const Matrix c = all_modes(Eigen::Map<const Matrix>(y.data(), dim_, columns_));
-  const Matrix dc = all_modes(Eigen::Map<const Matrix>(dy.data(), dim_, columns_));
-  const Matrix result = df_coefficients(to_grid(c), to_grid(dc));
+  const Matrix result = df_coefficients(to_grid(all_modes(Eigen::Map<const Matrix>(y.data(), dim_, columns_))),
+                                        to_grid(all_modes(Eigen::Map<const Matrix>(dy.data(), dim_, columns_))));
   out = Eigen::Map<const Vector>(result.data(), size());  // modes 0 .. columns_ - 1
 }
 
 void TwoScale::rhs(double t, const Vector& y, Vector& out) {
   nonlinear(t, y, out);
-  out += multipliers_.cwiseProduct(y);
+  algebra::diagonal_multiply_add(out, multipliers_, y, out);
 }
 
 Matrix TwoScale::to_grid(const Matrix& c) {
@@ -251,23 +298,22 @@ Matrix TwoScale::to_grid(const Matrix& c) {
     real_fft_->backward(c.data(), values.data());  // modes 0 .. N/2: the first columns of c
     return values.cast<Complex>();
   }
-  auto buffer = fft_->data();
-  buffer = c;
-  fft_->backward();
-  return buffer;
+  Matrix grid(dim_, n_tau_);
+  fft_->transform(c.data(), grid.data(), 1);
+  return grid;
 }
 
-Matrix TwoScale::to_coefficients(const Matrix& grid) {
+Matrix TwoScale::to_coefficients(Matrix grid) {
   if (real_layout_) {
     const RealMatrix values = grid.real();
+    grid.resize(0, 0);
     Matrix c(dim_, columns_);
     real_fft_->forward_unnormalised(values.data(), c.data());
-    return all_modes(c / static_cast<double>(n_tau_));
+    c *= 1.0 / n_tau_;
+    return all_modes(c);
   }
-  auto buffer = fft_->data();
-  buffer = grid;
-  fft_->forward();
-  return buffer;
+  fft_->transform(grid.data(), grid.data(), 0, 1.0 / n_tau_);
+  return grid;
 }
 
 Matrix TwoScale::all_modes(ConstMatrixRef stored) const {
@@ -286,23 +332,28 @@ double TwoScale::coefficient_norm(const Vector& y, bool without_mean) const {
   return std::sqrt(sum);
 }
 
-Matrix TwoScale::f_coefficients(const Matrix& grid) {
+Matrix TwoScale::f_coefficients(Matrix w) {
   ++evaluations_;
-  Matrix w = grid;
+  if (grid_field_->in_place()) {
+    grid_field_->evaluate(w, w);
+    return to_coefficients(std::move(w));
+  }
   Matrix f(dim_, n_tau_);
   grid_field_->evaluate(w, f);
-  return to_coefficients(f);
+  w.resize(0, 0);
+  return to_coefficients(std::move(f));
 }
 
-Matrix TwoScale::df_coefficients(const Matrix& grid, const Matrix& direction_grid) {
+Matrix TwoScale::df_coefficients(Matrix w, Matrix z) {
   ++evaluations_;
-  Matrix w = grid, z = direction_grid;
   model_->linear_flow(taus_, w);
   model_->linear_flow(taus_, z);
   Matrix df(dim_, n_tau_);
   model_->nonlinear_field_derivative(w, z, df);
+  w.resize(0, 0);
+  z.resize(0, 0);
   model_->linear_flow(RealVector(-taus_), df);
-  return to_coefficients(df);
+  return to_coefficients(std::move(df));
 }
 
 Matrix TwoScale::apply_A(Matrix c) const {
@@ -322,13 +373,16 @@ Complex TwoScale::antiderivative(int j) const {
 Matrix TwoScale::r1(const Vector& w) { return apply_A(f_coefficients(w.replicate(1, n_tau_))); }
 
 Matrix TwoScale::r2(const Vector& w) {
-  const Matrix w_grid = w.replicate(1, n_tau_);
-  const Matrix f = f_coefficients(w_grid);
-  const Matrix af_grid = to_grid(apply_A(f));
+  // At most four grids at once: the constant grid of w is made again for each use.
+  Matrix f = f_coefficients(w.replicate(1, n_tau_));
   Vector drift = f.col(0);  // the averaged field at w, Pi f(w) + JR w: constant in tau
   if (remainder_.size()) drift += remainder_.cwiseProduct(w);
-  Matrix r = apply_A(df_coefficients(w_grid, af_grid)) - apply_A(apply_A(df_coefficients(w_grid, drift.replicate(1, n_tau_))));
-  if (remainder_.size()) r += remainder_.asDiagonal() * apply_A(apply_A(f));
+  Matrix remainder_term;
+  if (remainder_.size()) remainder_term = remainder_.asDiagonal() * apply_A(apply_A(f));
+  Matrix af_grid = to_grid(apply_A(std::move(f)));
+  Matrix r = apply_A(df_coefficients(w.replicate(1, n_tau_), std::move(af_grid)));
+  r -= apply_A(apply_A(df_coefficients(w.replicate(1, n_tau_), drift.replicate(1, n_tau_))));
+  if (remainder_.size()) r += remainder_term;
   return r;
 }
 
@@ -374,20 +428,25 @@ Vector TwoScale::prepared_at(const Vector& v, double s) {
     c = trajectory_data(v, s);
   else
     c = closed_data(v, s);
-  return Eigen::Map<const Vector>(c.data(), size());
+  Vector out = Eigen::Map<const Vector>(c.data(), size());
+  return out;
 }
 
 Matrix TwoScale::closed_data(const Vector& v, double s) {
-  Matrix c = Matrix::Zero(dim_, n_tau_);
+  Matrix c;
+  if (data_order_ < 2) c = Matrix::Zero(dim_, n_tau_);
   if (data_order_ >= 2) {
     // eq. (2nd data) centred at s; order 3 evaluates r1 at vbar = v - eps r1(v)(s) and adds
     // eps^2 r2(v). s = 0 is the initial data.
     Matrix r = r1(v);
     if (data_order_ == 3) {
       const Vector vbar = v - eps_ * evaluate(r, s);
-      r = r1(vbar) + eps_ * r2(v);
+      r.resize(0, 0);  // r2's grids next, without it
+      r = eps_ * r2(v);
+      r = r1(vbar) + r;
     }
-    c = eps_ * r;
+    r *= eps_;
+    c = std::move(r);
     c.col(0) -= evaluate(c, s);  // U(s) = v exactly: subtract the value at tau = s
   }
   c.col(0) += v;
@@ -450,13 +509,16 @@ Matrix TwoScale::trajectory_data(const Vector& v, double s) {
   // + JR Phi^{k-1}(c_i) - (d/dsigma Phi^{k-1})(c_i) ], one evaluation per point and level. One
   // trajectory serves every level: a G off by dG costs eps^2 dG (eps A, and D Phi = O(eps)), so
   // the trajectory of the most accurate averaged field serves all orders below it.
-  Matrix data = Matrix::Zero(dim_, n_tau_);
-  data.col(0) = v;
   data_order_reached_ = 1;
-  if (data_order_ < 2) return data;
-  const Matrix f = f_coefficients(v.replicate(1, n_tau_));
+  if (data_order_ < 2) {
+    Matrix data = Matrix::Zero(dim_, n_tau_);
+    data.col(0) = v;
+    return data;
+  }
+  Matrix f = f_coefficients(v.replicate(1, n_tau_));
   if (data_order_ == 2) {  // Phi^2 = eps A f needs no trajectory
-    Matrix phi = eps_ * apply_A(f);
+    Matrix phi = apply_A(std::move(f));
+    phi *= eps_;
     phi.col(0) += v - evaluate(phi, s);
     data_order_reached_ = 2;
     return phi;
@@ -467,6 +529,7 @@ Matrix TwoScale::trajectory_data(const Vector& v, double s) {
   const bool remainder = remainder_.size() > 0;
   const SigmaNodes nodes(trajectory_point_count(data_order_, remainder));
   Vector drift = f.col(0);
+  f.resize(0, 0);
   if (remainder) drift += remainder_.cwiseProduct(v);
   const double speed = drift.norm() / v.norm();
   const double length = trajectory_length(static_cast<int>(nodes.x.size()), remainder);
@@ -479,6 +542,8 @@ Matrix TwoScale::trajectory_data(const Vector& v, double s) {
   // order 4 (38 evaluations: orders beyond it gain nothing there).
   if (!trajectory) return central_data(v, s, std::min(data_order_, central_fallback_order));
   const std::vector<Vector>& points = *trajectory;
+  Matrix data = Matrix::Zero(dim_, n_tau_);
+  data.col(0) = v;
   std::vector<Vector> previous(m, Vector::Zero(size())), next(m, Vector(size())), drifts(m);
   double last_correction = std::numeric_limits<double>::infinity();
   for (int k = 2; k <= data_order_; ++k) {

@@ -1,5 +1,6 @@
 #pragma once
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "tsi/fft.hpp"
@@ -33,6 +34,19 @@ class TwoScale final : public Reformulation {
  public:
   /// The largest order of prepared data.
   static constexpr int max_data_order = 8;
+  /// Models of at least this many unknowns without a remainder store L (and the schemes their
+  /// coefficients) once per tau mode; smaller ones per unknown (their vectors are small, and
+  /// whole-vector products are faster there than runs of a few entries).
+  static constexpr Index min_diagonal_run = 64;
+  /// The run of L's diagonal for this model (tsi::Diagonal::run): dim, or 1.
+  static Index diagonal_run(const Model& model);
+  /// The vectors of its size a two-scale problem holds besides the state at the peak of a run,
+  /// known before it is built: its work space (a grid buffer where the model's field is not
+  /// evaluated in place, allowed for here; a remainder's multipliers) and the largest
+  /// preparation of data of this order and method (their temporaries; freed before the run's
+  /// steps). `preparation` gets the latter alone.
+  static double work_vectors(const Model& model, int initial_data_order, const std::string& data_method,
+                             double* preparation = nullptr);
 
   /// How prepared data of order 2 and above is computed (docs/high-order.md, "Prepared data
   /// of any order").
@@ -51,7 +65,9 @@ class TwoScale final : public Reformulation {
   Index size() const override { return dim_ * columns_; }
   /// True when the state holds modes 0 .. N_tau/2 of a real U (the real layout).
   bool real_layout() const { return real_layout_; }
-  const Vector& linear_multipliers() const override { return multipliers_; }
+  /// True when a real_layout TwoScale of this model would use the real layout.
+  static bool real_layout_for(const Model& model);
+  const Diagonal& linear_multipliers() const override { return multipliers_; }
   const Vector& remainder_multipliers() const override { return remainder_grid_; }
   void nonlinear(double t, const Vector& y, Vector& out) override;
   void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
@@ -71,21 +87,22 @@ class TwoScale final : public Reformulation {
   int threads() const override { return threads_; }
 
  private:
-  /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau).
-  Matrix f_coefficients(const Matrix& grid);
-  /// Coefficients of Df_tau(W(tau)) Z(tau) for grid values W, Z.
-  Matrix df_coefficients(const Matrix& grid, const Matrix& direction_grid);
+  /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau), computed in W's storage where
+  /// the model evaluates in place.
+  Matrix f_coefficients(Matrix grid);
+  /// Coefficients of Df_tau(W(tau)) Z(tau) for grid values W, Z (consumed).
+  Matrix df_coefficients(Matrix grid, Matrix direction_grid);
   /// Grid values of the coefficients c (all N_tau modes).
   Matrix to_grid(const Matrix& c);
-  /// Coefficients (all N_tau modes) of grid values, normalised.
-  Matrix to_coefficients(const Matrix& grid);
+  /// Coefficients (all N_tau modes, normalised) of grid values (consumed).
+  Matrix to_coefficients(Matrix grid);
   /// All N_tau modes of coefficients in the state's layout (the real layout: the modes -k
   /// are the conjugates of the modes k).
   Matrix all_modes(ConstMatrixRef stored) const;
   /// The norm of the coefficients of a state as if all N_tau modes were stored.
   double coefficient_norm(const Vector& y, bool without_mean = false) const;
-  /// f_tau on the real tau grid (real layout): field_values_ = f(grid_values_) on columns
-  /// [c0, c0 + cn) with binding `field`.
+  /// f_tau on the real tau grid (real layout), in grid_values_ where the binding evaluates in
+  /// place, else into field_values_, on columns [c0, c0 + cn) with binding `field`.
   void evaluate_real_grid(TauGridField& field, Index c0, Index cn);
   /// nonlinear_shifted in the real layout.
   void nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& out);
@@ -153,17 +170,18 @@ class TwoScale final : public Reformulation {
   Vector remainder_;  // i omega per model coordinate (empty without a remainder)
   std::unique_ptr<TauGridField> grid_field_;  // f_tau on taus_, bound once
   RealVector wave_numbers_;  // k of each Fourier index; the Nyquist index holds n/2
-  Vector multipliers_;
+  Diagonal multipliers_;  // per tau mode without a remainder (diagonal_run), else per unknown
   Vector remainder_grid_;  // remainder_ on every tau point (empty without a remainder)
   int threads_;  // threads on the tau grid (tsi::tau_grid_threads_for); 1: the serial path
   std::vector<Index> column_begin_;  // threads_ + 1 boundaries of the threads' tau columns
   std::vector<std::unique_ptr<TauGridField>> column_fields_;  // f_tau on each thread's columns
   // Complex layout:
-  std::unique_ptr<FftBatch> fft_;        // U's coefficients -> its values on the tau grid
-  std::unique_ptr<FftBatch> field_fft_;  // f_tau(U) on the grid -> its coefficients: the model writes here
+  std::unique_ptr<FftBatch> fft_;  // the tau transforms, both ways, in threads_ parts (from and to the caller's memory)
+  Matrix field_;   // the field on the grid where the model does not evaluate in place (first use)
   // Real layout:
   std::unique_ptr<RealFftBatch> real_fft_;
-  RealMatrix grid_values_, field_values_;  // U and f_tau(U) on the real tau grid
+  RealMatrix grid_values_;   // U on the real tau grid (and f_tau(U) where the binding evaluates in place)
+  RealMatrix field_values_;  // f_tau(U) where it does not
   bool real_kernels_ = false;  // the bindings evaluate real grids; otherwise through complex copies:
   Matrix complex_grid_, complex_field_;
   Repreparation repreparation_;

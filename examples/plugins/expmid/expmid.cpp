@@ -24,7 +24,7 @@ class ExpMidpoint final : public tsi::Stepper {
   // entry of L's diagonal, computed here once, and the work vectors from the problem's prototype.
   ExpMidpoint(tsi::Problem& problem, double h, std::monostate)
       : Stepper(problem, h), n_(problem.new_state()), stage_(problem.new_state()) {
-    const Vector& lambda = problem.linear_multipliers();
+    const tsi::Diagonal& lambda = problem.linear_multipliers();
     tsi::diagonal_function(lambda, 0.5 * h, [](Complex z) { return std::exp(z); }, e_half_);
     tsi::diagonal_function(lambda, 0.5 * h, [h](Complex z) { return 0.5 * h * tsi::phi1(z); }, b_half_);
     tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_full_);
@@ -38,10 +38,16 @@ class ExpMidpoint final : public tsi::Stepper {
     tsi::algebra::diagonal_combination(e_full_, y, b_full_, n_, y);
   }
 
-  double state_vectors() const override { return 6.0; }
+  double state_vectors() const override { return state_vectors_for(problem_.layout(), {}); }
+  // Four coefficients (one value per tau mode on the two-scale problem without a remainder),
+  // N and the stage: what the footprint check of a run counts before the problem is built.
+  static double state_vectors_for(const tsi::ProblemLayout& layout, std::monostate) {
+    return 4.0 * layout.diagonal_fraction() + 2.0;
+  }
 
  private:
-  Vector e_half_, b_half_, e_full_, b_full_, n_, stage_;
+  tsi::Diagonal e_half_, b_half_, e_full_, b_full_;
+  Vector n_, stage_;
 };
 
 void register_expmid(tsi::Registry& registry) {

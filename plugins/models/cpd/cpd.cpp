@@ -90,6 +90,7 @@ class ChargedParticle final : public tsi::Model {
         : model_(model), cos_((0.5 * taus.array()).cos()), sin_((0.5 * taus.array()).sin()) {}
     void evaluate(MatrixRef u, MatrixRef out) override { model_.fused_field(cos_, sin_, u, out); }
     bool evaluates_real() const override { return true; }
+    bool in_place() const override { return true; }  // each column read before it is written
     void evaluate_real(tsi::RealMatrixRef u, tsi::RealMatrixRef out) override { model_.fused_field(cos_, sin_, u, out); }
 
    private:

@@ -15,6 +15,7 @@
 // from_physical the forward one, and errors are measured in the discrete L2 norm
 // sqrt(2 pi / N_x) |u|.
 #include <cmath>
+#include <algorithm>
 #include <complex>
 #include <memory>
 #include <mutex>
@@ -57,36 +58,43 @@ class Nls final : public tsi::Model {
       }
   }
 
-  // -i |u|^2 u on the grid, for all columns in one batched transform each way.
+  // -i |u|^2 u on the grid, in batched transforms each way (a slice of columns at a time).
   // With w = backward(c) = sqrt(2 pi) u:  out = -i forward(|w|^2 w) / (2 pi N_x).
   void nonlinear_field(ConstMatrixRef c, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridFft& b = batch(c.cols());
-    auto w = b.data();  // row j: state j
-    w = c.transpose();
-    b.backward();
+    tsi::GridFft& b = batch(slice(c.cols()));
     const Complex scale(0.0, -1.0 / (tsi::two_pi * n_x_));
-    for (Index i = 0; i < n_x_; ++i)
-      for (Index j = 0; j < w.rows(); ++j) w(j, i) *= scale * std::norm(w(j, i));
-    b.forward();
-    out = w.transpose();
+    for (Index j0 = 0; j0 < c.cols(); j0 += b.columns()) {
+      const Index k = std::min(b.columns(), c.cols() - j0);
+      auto w = b.data();  // row j: state j0 + j
+      w.topRows(k) = c.middleCols(j0, k).transpose();
+      if (k < w.rows()) w.bottomRows(w.rows() - k).setZero();
+      b.backward();
+      for (Index i = 0; i < n_x_; ++i)
+        for (Index j = 0; j < w.rows(); ++j) w(j, i) *= scale * std::norm(w(j, i));
+      b.forward();
+      out.middleCols(j0, k) = w.topRows(k).transpose();
+    }
   }
 
   void filtered_field(const tsi::RealVector& taus, MatrixRef c, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    fused_field(phase_table(taus, n_x_), batch(c.cols()), c, out);
+    fused_field(taus, batch(slice(c.cols())), c, out);
   }
 
-  // A run's tau grid: the phases, and transforms of its own (no lock: one run's work space).
+  // A run's tau grid: its phases, and transforms of its own for a slice of the grid's columns
+  // (no lock: one run's work space). It evaluates in place: each slice of columns is read
+  // into the transforms before it is written.
   class GridField final : public tsi::TauGridField {
    public:
     GridField(const Nls& model, const tsi::RealVector& taus)
-        : model_(model), phase_(phase_table(taus, model.n_x_)), batch_(model.n_x_, taus.size()) {}
-    void evaluate(MatrixRef c, MatrixRef out) override { model_.fused_field(phase_, batch_, c, out); }
+        : model_(model), taus_(taus), batch_(model.n_x_, model.slice(taus.size())) {}
+    void evaluate(MatrixRef c, MatrixRef out) override { model_.fused_field(taus_, batch_, c, out); }
+    bool in_place() const override { return true; }
 
    private:
     const Nls& model_;
-    tsi::Matrix phase_;
+    tsi::RealVector taus_;
     tsi::GridFft batch_;
   };
 
@@ -99,30 +107,41 @@ class Nls final : public tsi::Model {
   // f_tau in one pass each way: the phases e^{-i m^2 tau} are applied while the states are
   // copied (transposed) into the x-batch, and their conjugates (the flow at -tau) while the
   // result is copied out; the cubic term is written out in real arithmetic (-i a w = (a im, -a re)).
-  void fused_field(const tsi::Matrix& phase, tsi::GridFft& b, MatrixRef c, MatrixRef out) const {
-    auto w = b.data();  // row j: state j
+  // The phases come from phase_table's recurrence, column by column as they are needed (the
+  // same products: no table of the state's half size). A slice of b.columns() columns at a
+  // time, each read before it is written: out may be c.
+  void fused_field(const tsi::RealVector& taus, tsi::GridFft& b, MatrixRef c, MatrixRef out) const {
     const int half = n_x_ / 2;
-    for (Index j = 0; j < c.cols(); ++j) {
-      w(j, 0) = c(0, j);
-      for (int m = 1; m <= half; ++m) {
-        w(j, m) = times(c(m, j), phase(m, j));
-        if (n_x_ - m != m) w(j, n_x_ - m) = times(c(n_x_ - m, j), phase(m, j));
-      }
-    }
-    b.backward();
     const double scale = 1.0 / (tsi::two_pi * n_x_);
-    double* p = reinterpret_cast<double*>(w.data());
-    for (Index i = 0; i < 2 * w.size(); i += 2) {
-      const double re = p[i], im = p[i + 1], a = scale * (re * re + im * im);
-      p[i] = a * im;
-      p[i + 1] = -a * re;
-    }
-    b.forward();
-    for (Index j = 0; j < c.cols(); ++j) {
-      out(0, j) = w(j, 0);
-      for (int m = 1; m <= half; ++m) {
-        out(m, j) = times_conj(w(j, m), phase(m, j));
-        if (n_x_ - m != m) out(n_x_ - m, j) = times_conj(w(j, n_x_ - m), phase(m, j));
+    for (Index j0 = 0; j0 < c.cols(); j0 += b.columns()) {
+      const Index k = std::min(b.columns(), c.cols() - j0);
+      auto w = b.data();  // row j: state j0 + j
+      for (Index j = 0; j < k; ++j) {
+        PhaseRecurrence phase(taus(j0 + j));
+        w(j, 0) = c(0, j0 + j);
+        for (int m = 1; m <= half; ++m) {
+          const Complex e = phase.next();
+          w(j, m) = times(c(m, j0 + j), e);
+          if (n_x_ - m != m) w(j, n_x_ - m) = times(c(n_x_ - m, j0 + j), e);
+        }
+      }
+      if (k < w.rows()) w.bottomRows(w.rows() - k).setZero();
+      b.backward();
+      double* p = reinterpret_cast<double*>(w.data());
+      for (Index i = 0; i < 2 * w.size(); i += 2) {
+        const double re = p[i], im = p[i + 1], a = scale * (re * re + im * im);
+        p[i] = a * im;
+        p[i + 1] = -a * re;
+      }
+      b.forward();
+      for (Index j = 0; j < k; ++j) {
+        PhaseRecurrence phase(taus(j0 + j));
+        out(0, j0 + j) = w(j, 0);
+        for (int m = 1; m <= half; ++m) {
+          const Complex e = phase.next();
+          out(m, j0 + j) = times_conj(w(j, m), e);
+          if (n_x_ - m != m) out(n_x_ - m, j0 + j) = times_conj(w(j, n_x_ - m), e);
+        }
       }
     }
   }
@@ -130,22 +149,30 @@ class Nls final : public tsi::Model {
   // D(-i |u|^2 u) z = -i (2 |u|^2 z + u^2 conj(z)), on the grid, same scaling as above.
   void nonlinear_field_derivative(ConstMatrixRef c, ConstMatrixRef dc, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridFft& b = batch(c.cols());
+    // A large batch (the prepared data's, a run's tau grid) gets transforms of its own for this
+    // call, freed after it: the derivative is not needed while the run steps.
+    std::unique_ptr<tsi::GridFft> own;
+    if (slice(c.cols()) < c.cols()) own = std::make_unique<tsi::GridFft>(n_x_, slice(c.cols()));
+    tsi::GridFft& b = own ? *own : batch(c.cols());
     tsi::Matrix& grid = b.scratch();
-    auto w = b.data();  // row j: state j
-    w = c.transpose();
-    b.backward();
-    grid = w;
-    w = dc.transpose();
-    b.backward();
     const Complex scale(0.0, -1.0 / (tsi::two_pi * n_x_));
-    for (Index i = 0; i < n_x_; ++i)
-      for (Index j = 0; j < w.rows(); ++j) {
-        const Complex g = grid(j, i), z = w(j, i);
-        w(j, i) = scale * (2.0 * std::norm(g) * z + g * g * std::conj(z));
-      }
-    b.forward();
-    out = w.transpose();
+    for (Index j0 = 0; j0 < c.cols(); j0 += b.columns()) {
+      const Index k = std::min(b.columns(), c.cols() - j0);
+      auto w = b.data();  // row j: state j0 + j
+      w.topRows(k) = c.middleCols(j0, k).transpose();
+      if (k < w.rows()) w.bottomRows(w.rows() - k).setZero();
+      b.backward();
+      grid = w;
+      w.topRows(k) = dc.middleCols(j0, k).transpose();
+      b.backward();
+      for (Index i = 0; i < n_x_; ++i)
+        for (Index j = 0; j < w.rows(); ++j) {
+          const Complex g = grid(j, i), z = w(j, i);
+          w(j, i) = scale * (2.0 * std::norm(g) * z + g * g * std::conj(z));
+        }
+      b.forward();
+      out.middleCols(j0, k) = w.topRows(k).transpose();
+    }
   }
 
   void apply_M(const Vector& u, Vector& out) const override {
@@ -247,6 +274,27 @@ class Nls final : public tsi::Model {
   // sees two or three batch sizes (1 and N_tau), so nothing is planned inside a step after
   // the first call. Callers hold mutex_.
   tsi::GridFft& batch(Index columns) const { return batches_.get(columns); }
+
+  // Columns a batched call transforms at once: a large batch (a run's tau grid) goes through
+  // the x transforms a slice at a time, so the model's work space is a slice of the state.
+  static constexpr Index slice_columns = 32;
+  Index slice(Index columns) const {
+    return static_cast<Index>(n_x_) * columns >= (Index{1} << 16) ? std::min(columns, slice_columns) : columns;
+  }
+
+  // e^{-i m^2 tau} for m = 1, 2, ... in turn, by phase_table's recurrence (the same products).
+  class PhaseRecurrence {
+   public:
+    explicit PhaseRecurrence(double tau) : z_(std::polar(1.0, -tau)), z2_(z_ * z_), factor_(z_) {}
+    Complex next() {
+      phase_ *= factor_;
+      factor_ *= z2_;
+      return phase_;
+    }
+
+   private:
+    Complex z_, z2_, phase_ = 1.0, factor_;
+  };
 
   // e^{-i m^2 tau_j} for m = 0 .. N_x/2 (rows) and every tau_j (columns), by the recurrence
   // e^{-i (m+1)^2 tau} = e^{-i m^2 tau} e^{-i (2m+1) tau}: one sincos per column, rounding of

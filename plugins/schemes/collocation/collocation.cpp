@@ -37,10 +37,12 @@ class Collocation final : public tsi::Stepper {
         nodes_(tsi::gauss_legendre(settings.stages).nodes),
         solver_(tsi::make_fixed_point_solver(settings.options)),
         guess_(settings.options),
+        options_(settings.options),
         stage_(problem.new_state()) {
-    // The coefficients of step size h, with the factor h folded into a and b.
+    // The coefficients of step size h, with the factor h folded into a and b (one value per tau
+    // mode on the two-scale problem without a remainder: tsi::Diagonal).
     const tsi::InterpolatoryWeights weights_of(nodes_);
-    const Vector& lambda = problem.linear_multipliers();
+    const tsi::Diagonal& lambda = problem.linear_multipliers();
     const auto scaled = [&](double kappa) {
       return [&, kappa](Complex z) {
         std::vector<Complex> w = weights_of(kappa, z);
@@ -48,9 +50,9 @@ class Collocation final : public tsi::Stepper {
         return w;
       };
     };
-    a_.assign(s_, std::vector<Vector>(s_));
-    b_.assign(s_, Vector());
-    e_stage_.assign(s_, Vector());
+    a_.assign(s_, std::vector<tsi::Diagonal>(s_));
+    b_.assign(s_, tsi::Diagonal());
+    e_stage_.assign(s_, tsi::Diagonal());
     n_stage_.assign(s_, problem.new_state());
     tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_full_);
     tsi::diagonal_functions(lambda, h, scaled(1.0), pointers(b_));
@@ -60,25 +62,30 @@ class Collocation final : public tsi::Stepper {
       tsi::diagonal_functions(lambda, h, scaled(c), pointers(a_[i]));
     }
     stages_ = Vector::Zero(s_ * problem.size());
-    base_ = stages_;
-    a_terms_.resize(s_), n_terms_.resize(s_), b_terms_.resize(s_ + 1), y_terms_.resize(s_ + 1);
-    for (int j = 0; j < s_; ++j) n_terms_[j] = &n_stage_[j];
+    a_terms_.resize(s_ + 1), n_terms_.resize(s_ + 1), b_terms_.resize(s_ + 1), y_terms_.resize(s_ + 1);
+    for (int j = 0; j < s_; ++j) n_terms_[j + 1] = &n_stage_[j];
   }
 
   void reset() override { guess_.reset(); }
 
+  // The stages' bases e^{c_i z} y_n are not stored: every sweep forms them again in the pass
+  // that adds the a_ij N_j (the same products in the same order), s vectors less.
   void step(double t, Vector& y) override {
     const tsi::Index n = y.size();
-    for (int i = 0; i < s_; ++i) base_.segment(i * n, n) = e_stage_[i].cwiseProduct(y);
     // Starting guess: the stages with the previous step's N, else the linear flow alone.
-    tsi::algebra::copy(base_, stages_);
-    if (guess_.from_previous()) stage_map(n, base_, stages_);
+    if (guess_.from_previous())
+      stage_map(n, y, stages_);
+    else
+      for (int i = 0; i < s_; ++i) {
+        tsi::algebra::diagonal_multiply(e_stage_[i], y, stage_);
+        stages_.segment(i * n, n) = stage_;
+      }
     solver_->solve(stages_, [&](const Vector& x, Vector& out) {
       for (int j = 0; j < s_; ++j) {
         stage_ = x.segment(j * n, n);  // preallocated: a copy, no allocation
         problem_.nonlinear(t + nodes_[j] * h_, stage_, n_stage_[j]);
       }
-      stage_map(n, base_, out);
+      stage_map(n, y, out);
     });
     // y_{n+1} = e^{z} y_n + sum_j h b_j N_j, in one pass.
     b_terms_[0] = &e_full_, y_terms_[0] = &y;
@@ -88,26 +95,31 @@ class Collocation final : public tsi::Stepper {
   }
 
   tsi::SolverStats stats() const override { return solver_->stats(); }
-  // a (s^2), b, e_stage, N (s each) and e_full, one stage; stages and base are s each.
-  double state_vectors() const override {
-    const double s = s_;
-    return s * s + 3.0 * s + 2.0 + 2.0 * s + s * solver_->state_vectors();
+  double state_vectors() const override { return state_vectors_for(problem_.layout(), {s_, options_}); }
+  // a (s^2), b, e_stage (s each) and e_full; the s values of N, one stage, and the s stages
+  // with the solver's work space on them.
+  static double state_vectors_for(const tsi::ProblemLayout& layout, const Settings& settings) {
+    const double s = settings.stages;
+    return (s * s + 2.0 * s + 1.0) * layout.diagonal_fraction() + s + 1.0 + s +
+           s * tsi::fixed_point_state_vectors(settings.options);
   }
 
  private:
-  static std::vector<Vector*> pointers(std::vector<Vector>& v) {
-    std::vector<Vector*> p;
-    for (Vector& x : v) p.push_back(&x);
+  template <class T>
+  static std::vector<T*> pointers(std::vector<T>& v) {
+    std::vector<T*> p;
+    for (T& x : v) p.push_back(&x);
     return p;
   }
 
-  // out_i = base_i + sum_j h a_ij N_j for the stored stage values N_j (out may be base).
-  void stage_map(tsi::Index n, const Vector& base, Vector& out) {
+  // out_i = e^{c_i z} y + sum_j h a_ij N_j for the stored stage values N_j, one stage at a time
+  // through stage_ (the segments as vectors of their own would be copies).
+  void stage_map(tsi::Index n, const Vector& y, Vector& out) {
+    a_terms_[0] = nullptr, n_terms_[0] = &y;
     for (int i = 0; i < s_; ++i) {
-      for (int j = 0; j < s_; ++j) a_terms_[j] = &a_[i][j];
-      // The segments as vectors of their own would be copies: one stage at a time through stage_.
-      stage_ = base.segment(i * n, n);
-      tsi::algebra::diagonal_linear_combination(&stage_, a_terms_, n_terms_, stage_);
+      a_terms_[0] = &e_stage_[i];
+      for (int j = 0; j < s_; ++j) a_terms_[j + 1] = &a_[i][j];
+      tsi::algebra::diagonal_linear_combination(nullptr, a_terms_, n_terms_, stage_);
       out.segment(i * n, n) = stage_;
     }
   }
@@ -116,10 +128,14 @@ class Collocation final : public tsi::Stepper {
   std::vector<double> nodes_;
   std::unique_ptr<tsi::FixedPointSolver> solver_;
   tsi::StageGuess guess_;
-  std::vector<std::vector<Vector>> a_;
-  std::vector<Vector> b_, e_stage_, n_stage_;
-  Vector e_full_, stages_, base_, stage_;
-  std::vector<const Vector*> a_terms_, n_terms_, b_terms_, y_terms_;  // operand lists, allocated once
+  tsi::FixedPointOptions options_;
+  std::vector<std::vector<tsi::Diagonal>> a_;
+  std::vector<tsi::Diagonal> b_, e_stage_;
+  tsi::Diagonal e_full_;
+  std::vector<Vector> n_stage_;
+  Vector stages_, stage_;
+  std::vector<const tsi::Diagonal*> a_terms_, b_terms_;  // operand lists, allocated once
+  std::vector<const Vector*> n_terms_, y_terms_;
 };
 
 tsi::StepperTraits traits_of(int stages) {

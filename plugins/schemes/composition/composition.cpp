@@ -114,6 +114,13 @@ class CompositionScheme final : public tsi::Scheme {
   std::unique_ptr<tsi::Stepper> bind(tsi::Problem& problem, double h) const override {
     return std::make_unique<Composition>(problem, h, *base_, method_);
   }
+  // The base bound once per distinct substep length.
+  double state_vectors(const tsi::ProblemLayout& layout) const override {
+    std::vector<double> lengths;
+    for (double w : method_.weights)
+      if (std::find(lengths.begin(), lengths.end(), w) == lengths.end()) lengths.push_back(w);
+    return static_cast<double>(lengths.size()) * base_->state_vectors(layout);
+  }
 
  private:
   std::unique_ptr<tsi::Scheme> base_;

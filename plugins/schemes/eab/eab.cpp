@@ -27,17 +27,18 @@ constexpr int max_order = 6;
 
 class Eab final : public tsi::Stepper {
  public:
-  Eab(tsi::Problem& problem, double h, int order) : Stepper(problem, h), r_(order), next_(problem.new_state()) {
+  Eab(tsi::Problem& problem, double h, int order) : Stepper(problem, h), r_(order) {
     // The weights of N_{-j} for the value at kappa h: kappa = 1 the step, -k the start-up,
-    // with the factor h folded in.
+    // with the factor h folded in (one value per tau mode on the two-scale problem without a
+    // remainder: tsi::Diagonal).
     const tsi::InterpolatoryWeights weights_of(past_nodes(r_));
-    const Vector& lambda = problem.linear_multipliers();
-    weights_.assign(r_, std::vector<Vector>(r_));
-    exponentials_.assign(r_, Vector());
+    const tsi::Diagonal& lambda = problem.linear_multipliers();
+    weights_.assign(r_, std::vector<tsi::Diagonal>(r_));
+    exponentials_.assign(r_, tsi::Diagonal());
     for (int k = 0; k < r_; ++k) {
       const double kappa = k == 0 ? 1.0 : -static_cast<double>(k);
       tsi::diagonal_function(lambda, h, [kappa](Complex z) { return std::exp(kappa * z); }, exponentials_[k]);
-      std::array<Vector*, max_order> outs{};
+      std::array<tsi::Diagonal*, max_order> outs{};
       for (int j = 0; j < r_; ++j) outs[j] = &weights_[k][j];
       tsi::diagonal_functions(
           lambda, h,
@@ -46,32 +47,36 @@ class Eab final : public tsi::Stepper {
             for (Complex& x : w) x *= h;
             return w;
           },
-          std::span<Vector* const>(outs.data(), r_));
+          std::span<tsi::Diagonal* const>(outs.data(), r_));
     }
     history_.assign(r_, problem.new_state());
-    past_.assign(r_, problem.new_state());
+    past_.assign(r_ - 1, problem.new_state());
   }
 
   void reset() override { started_ = false; }
 
   void step(double t, Vector& y) override {
     if (!started_) start(t, y);
-    combine(0, y, next_);
-    y.swap(next_);
+    combine(0, y, y);  // in place: the combination reads each entry before it writes it
     // The history moves back one place (swaps, no copies) and N_{n+1} takes the front.
     for (int j = r_ - 1; j > 0; --j) history_[j].swap(history_[j - 1]);
     problem_.nonlinear(t + h_, y, history_.front());
   }
 
-  double state_vectors() const override { return (r_ + 1.0) * r_ + 2.0 * r_ + 1.0; }
+  double state_vectors() const override { return state_vectors_for(problem_.layout(), r_); }
+  // (r + 1) r coefficients; the history of r values of N and the start-up's r - 1 past values.
+  static double state_vectors_for(const tsi::ProblemLayout& layout, int r) {
+    return (r + 1.0) * r * layout.diagonal_fraction() + 2.0 * r - 1.0;
+  }
 
  private:
-  // out = e^{kappa_k hL} y + sum_j h w_j(kappa_k) N_{-j}, in one pass.
+  // out = e^{kappa_k hL} y + sum_j h w_j(kappa_k) N_{-j}, in one pass (out may be y).
   void combine(int k, const Vector& y, Vector& out) const {
-    std::array<const Vector*, max_order + 1> d{}, x{};
+    std::array<const tsi::Diagonal*, max_order + 1> d{};
+    std::array<const Vector*, max_order + 1> x{};
     d[0] = &exponentials_[k], x[0] = &y;
     for (int j = 0; j < r_; ++j) d[j + 1] = &weights_[k][j], x[j + 1] = &history_[j];
-    tsi::algebra::diagonal_linear_combination(nullptr, std::span<const Vector* const>(d.data(), r_ + 1),
+    tsi::algebra::diagonal_linear_combination(nullptr, std::span<const tsi::Diagonal* const>(d.data(), r_ + 1),
                                               std::span<const Vector* const>(x.data(), r_ + 1), out);
   }
 
@@ -80,8 +85,8 @@ class Eab final : public tsi::Stepper {
     problem_.nonlinear(t, y, history_[0]);
     for (int j = 1; j < r_; ++j) tsi::algebra::copy(history_[0], history_[j]);
     for (int pass = 0; pass < r_; ++pass) {
-      for (int k = 1; k < r_; ++k) combine(k, y, past_[k]);
-      for (int k = 1; k < r_; ++k) problem_.nonlinear(t - k * h_, past_[k], history_[k]);
+      for (int k = 1; k < r_; ++k) combine(k, y, past_[k - 1]);
+      for (int k = 1; k < r_; ++k) problem_.nonlinear(t - k * h_, past_[k - 1], history_[k]);
     }
     started_ = true;
   }
@@ -94,11 +99,10 @@ class Eab final : public tsi::Stepper {
 
   int r_;
   bool started_ = false;
-  std::vector<std::vector<Vector>> weights_;  // [k][j]: k = 0 the step, k >= 1 the value at -k h
-  std::vector<Vector> exponentials_;          // [k]: e^{kappa_k h L}
-  Vector next_;
+  std::vector<std::vector<tsi::Diagonal>> weights_;  // [k][j]: k = 0 the step, k >= 1 the value at -k h
+  std::vector<tsi::Diagonal> exponentials_;          // [k]: e^{kappa_k h L}
   std::vector<Vector> history_;  // N_n, N_{n-1}, ..., N_{n-r+1}
-  std::vector<Vector> past_;     // the start-up's values at t - k h
+  std::vector<Vector> past_;     // the start-up's values at t - k h, k = 1 .. r - 1
 };
 
 tsi::StepperTraits traits_of_order(int r) {

@@ -12,9 +12,11 @@
 // phase wrong by (h omega_j)^3/12 per step: on Klein-Gordon it was all of FD's error.)
 #include <cmath>
 #include <memory>
+#include <utility>
 #include <variant>
 
 #include "tsi/algebra.hpp"
+#include "tsi/diagonal.hpp"
 #include "tsi/plugin.hpp"
 
 namespace {
@@ -27,19 +29,27 @@ class Fd final : public tsi::Stepper {
  public:
   Fd(tsi::Problem& problem, double h, std::monostate)
       : Stepper(problem, h), half_(problem.new_state()), n_(problem.new_state()) {
-    const Vector& lambda = problem.linear_multipliers();
+    const tsi::Diagonal& lambda = problem.linear_multipliers();
     const Vector& remainder = problem.remainder_multipliers();
-    const tsi::Index n = lambda.size();
-    inverse_.resize(n), half_inverse_.resize(n), cayley_.resize(n), full_inverse_.resize(n);
+    // One value per stored value of L (per tau mode on the two-scale problem without a
+    // remainder); a remainder varies along every run, so with one L is taken entry by entry.
+    const tsi::Index run = remainder.size() ? 1 : lambda.run();
+    const Vector values = run == lambda.run() ? lambda.values() : lambda.expanded();
+    const tsi::Index n = values.size();
+    Vector inverse(n), half_inverse(n), cayley(n), full_inverse(n);
     for (tsi::Index i = 0; i < n; ++i) {
       const Complex r = remainder.size() ? remainder(i) : Complex(0.0);
-      const Complex z = 0.5 * h * (lambda(i) - r);  // h L_tau / 2
-      const Complex half_turn = std::exp(0.5 * h * r), inverse = 1.0 / (1.0 - z);
-      inverse_(i) = half_turn * inverse;
-      half_inverse_(i) = 0.5 * h * half_turn * inverse;
-      cayley_(i) = half_turn * half_turn * (1.0 + z) * inverse;
-      full_inverse_(i) = h * half_turn * inverse;
+      const Complex z = 0.5 * h * (values(i) - r);  // h L_tau / 2
+      const Complex half_turn = std::exp(0.5 * h * r), inv = 1.0 / (1.0 - z);
+      inverse(i) = half_turn * inv;
+      half_inverse(i) = 0.5 * h * half_turn * inv;
+      cayley(i) = half_turn * half_turn * (1.0 + z) * inv;
+      full_inverse(i) = h * half_turn * inv;
     }
+    inverse_ = tsi::Diagonal(std::move(inverse), run);
+    half_inverse_ = tsi::Diagonal(std::move(half_inverse), run);
+    cayley_ = tsi::Diagonal(std::move(cayley), run);
+    full_inverse_ = tsi::Diagonal(std::move(full_inverse), run);
   }
 
   void step(double t, Vector& y) override {
@@ -49,11 +59,15 @@ class Fd final : public tsi::Stepper {
     algebra::diagonal_combination(cayley_, y, full_inverse_, n_, y);
   }
 
-  double state_vectors() const override { return 6.0; }
+  double state_vectors() const override { return state_vectors_for(problem_.layout(), {}); }
+  // Four coefficients (per unknown with a remainder), the half step and N.
+  static double state_vectors_for(const tsi::ProblemLayout& layout, std::monostate) {
+    return 4.0 * layout.diagonal_fraction() + 2.0;
+  }
 
  private:
   // With E = e^{hR/2} and C = (1 - h L_tau/2)^{-1}: E C, (h/2) E C, E^2 C (1 + h L_tau/2), h E C
-  Vector inverse_, half_inverse_, cayley_, full_inverse_;
+  tsi::Diagonal inverse_, half_inverse_, cayley_, full_inverse_;
   Vector half_, n_;
 };
 

@@ -19,17 +19,13 @@ using tsi::Vector;
 class Me final : public tsi::Stepper {
  public:
   Me(tsi::Problem& problem, double h, std::monostate)
-      : Stepper(problem, h),
-        n_(problem.new_state()),
-        previous_(problem.new_state()),
-        star_(problem.new_state()),
-        n_star_(problem.new_state()) {
-    const Vector& lambda = problem.linear_multipliers();
+      : Stepper(problem, h), n_(problem.new_state()), previous_(problem.new_state()) {
+    const tsi::Diagonal& lambda = problem.linear_multipliers();
     tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_);
     tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi1(z); }, p1_);
     tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi2(z); }, p2_);
-    p12_ = p1_ + p2_;
-    minus_p2_ = -p2_;
+    p12_ = tsi::Diagonal(p1_.values() + p2_.values(), lambda.run());
+    minus_p2_ = tsi::Diagonal(-p2_.values(), lambda.run());
   }
 
   void reset() override { has_previous_ = false; }
@@ -38,22 +34,27 @@ class Me final : public tsi::Stepper {
     problem_.nonlinear(t, y, n_);
     if (has_previous_) {
       algebra::diagonal_combination(e_, y, p12_, n_, minus_p2_, previous_, y);
-    } else {  // the start-up step
-      algebra::diagonal_combination(e_, y, p1_, n_, star_);
-      problem_.nonlinear(t + h_, star_, n_star_);
-      algebra::axpby(1.0, n_star_, -1.0, n_, n_star_);
-      algebra::diagonal_multiply_add(star_, p2_, n_star_, y);
+    } else {  // the start-up step, in the history's slot (empty until now) and in y
+      Vector& star = previous_;
+      algebra::diagonal_combination(e_, y, p1_, n_, star);
+      problem_.nonlinear(t + h_, star, y);  // N(U^*)
+      algebra::axpby(1.0, y, -1.0, n_, y);
+      algebra::diagonal_multiply_add(star, p2_, y, y);
     }
     previous_.swap(n_);
     has_previous_ = true;
   }
 
-  double state_vectors() const override { return 9.0; }
+  double state_vectors() const override { return state_vectors_for(problem_.layout(), {}); }
+  // Five coefficients, N and the previous N (the start-up works in these and y).
+  static double state_vectors_for(const tsi::ProblemLayout& layout, std::monostate) {
+    return 5.0 * layout.diagonal_fraction() + 2.0;
+  }
 
  private:
   bool has_previous_ = false;
-  Vector e_, p1_, p2_, p12_, minus_p2_;  // the coefficients of step size h; p12 = p1 + p2
-  Vector n_, previous_, star_, n_star_;
+  tsi::Diagonal e_, p1_, p2_, p12_, minus_p2_;  // the coefficients of step size h; p12 = p1 + p2
+  Vector n_, previous_;
 };
 
 void register_me(tsi::Registry& registry) {

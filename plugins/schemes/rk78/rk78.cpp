@@ -118,7 +118,9 @@ class Rk78 final : public tsi::Stepper {
 
   // The state, its rounding and the deviation (real pairs), the field's argument and value;
   // odeint's pair holds 13 stages and 3 temporaries more, allocated on its first step.
-  double state_vectors() const override { return 5.0 + 16.0; }
+  double state_vectors() const override { return state_vectors_for(problem_.layout(), {}); }
+  // Its own work vectors and odeint's stages, whatever the layout.
+  static double state_vectors_for(const tsi::ProblemLayout&, const Settings&) { return 5.0 + 16.0; }
 
  private:
   // hi + lo += x, with the rounding of hi + x carried in lo (Knuth's two-sum).

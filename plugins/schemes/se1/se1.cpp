@@ -16,11 +16,12 @@ namespace algebra = tsi::algebra;
 using tsi::Complex;
 using tsi::Vector;
 
-// The diagonal coefficients of step size h: the binding's cache.
+// The diagonal coefficients of step size h: the binding's cache (one value per tau mode on the
+// two-scale problem without a remainder: tsi::Diagonal).
 struct Coefficients {
-  Vector e_half, b_half, e_full, b_full;
+  tsi::Diagonal e_half, b_half, e_full, b_full;
   Coefficients(const tsi::Problem& problem, double h) {
-    const Vector& lambda = problem.linear_multipliers();
+    const tsi::Diagonal& lambda = problem.linear_multipliers();
     tsi::diagonal_function(lambda, 0.5 * h, [](Complex z) { return std::exp(z); }, e_half);
     tsi::diagonal_function(lambda, 0.5 * h, [h](Complex z) { return 0.5 * h * tsi::phi1(z); }, b_half);
     tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_full);
@@ -36,22 +37,22 @@ class Se1 final : public tsi::Stepper {
         solver_(tsi::make_fixed_point_solver(options)),
         guess_(options),
         y_half_(problem.new_state()),
-        base_half_(problem.new_state()),
         n_half_(problem.new_state()) {}
 
   void reset() override { guess_.reset(); }
 
+  // The stage's base e^{z/2} U^n is not stored: each sweep forms it again in the same pass
+  // (the same products, rounded the same way), one vector less than a stored base.
   void step(double t, Vector& y) override {
-    algebra::diagonal_multiply(c_.e_half, y, base_half_);
     // Starting guess: the stage with the previous step's N(U^{n-1/2}), an O(h^2) predictor.
     if (guess_.from_previous())
-      algebra::diagonal_multiply_add(base_half_, c_.b_half, n_half_, y_half_);
+      algebra::diagonal_combination(c_.e_half, y, c_.b_half, n_half_, y_half_);
     else
-      algebra::copy(base_half_, y_half_);
+      algebra::diagonal_multiply(c_.e_half, y, y_half_);
     const double t_half = t + 0.5 * h_;
     solver_->solve(y_half_, [&](const Vector& x, Vector& out) {
       problem_.nonlinear(t_half, x, n_half_);
-      algebra::diagonal_multiply_add(base_half_, c_.b_half, n_half_, out);
+      algebra::diagonal_combination(c_.e_half, y, c_.b_half, n_half_, out);
     });
     // n_half_ = N at the last-but-one iterate, within tol of N(U^{n+1/2}).
     algebra::diagonal_combination(c_.e_full, y, c_.b_full, n_half_, y);
@@ -59,13 +60,18 @@ class Se1 final : public tsi::Stepper {
   }
 
   tsi::SolverStats stats() const override { return solver_->stats(); }
-  double state_vectors() const override { return 7.0 + solver_->state_vectors(); }
+  double state_vectors() const override { return state_vectors_for(problem_.layout(), options_); }
+  // Four coefficients, the stage and its N, and the solver's work space.
+  static double state_vectors_for(const tsi::ProblemLayout& layout, const tsi::FixedPointOptions& options) {
+    return 4.0 * layout.diagonal_fraction() + 2.0 + tsi::fixed_point_state_vectors(options);
+  }
 
  private:
   Coefficients c_;
   std::unique_ptr<tsi::FixedPointSolver> solver_;
   tsi::StageGuess guess_;
-  Vector y_half_, base_half_, n_half_;
+  tsi::FixedPointOptions options_ = solver_->options();
+  Vector y_half_, n_half_;
 };
 
 void register_se1(tsi::Registry& registry) {

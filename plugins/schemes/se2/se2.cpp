@@ -30,9 +30,8 @@ class Se2 final : public tsi::Stepper {
         solver_(tsi::make_fixed_point_solver(settings.options)),
         guess_(settings.options),
         rule_(tsi::gauss_legendre(settings.nodes)),
-        base_(problem.new_state()),
+        options_(settings.options),
         next_(problem.new_state()),
-        stage_(problem.new_state()),
         n_(problem.new_state()),
         average_(problem.new_state()) {
     tsi::diagonal_function(problem.linear_multipliers(), h, [](Complex z) { return std::exp(z); }, e_);
@@ -41,36 +40,43 @@ class Se2 final : public tsi::Stepper {
 
   void reset() override { guess_.reset(); }
 
+  // The base e^z U^n is not stored: each sweep forms it again in its last pass (the same
+  // products, rounded the same way), one vector less.
   void step(double t, Vector& y) override {
-    algebra::diagonal_multiply(e_, y, base_);
     // Starting guess: the previous step's averaged N, an O(h^2) predictor.
     if (guess_.from_previous())
-      algebra::diagonal_multiply_add(base_, b_, average_, next_);
+      algebra::diagonal_combination(e_, y, b_, average_, next_);
     else
-      algebra::copy(base_, next_);
+      algebra::diagonal_multiply(e_, y, next_);
+    // A quadrature point's state goes in `out` (free until the map's result is written there).
     solver_->solve(next_, [&](const Vector& x, Vector& out) {
       algebra::set_zero(y.size(), average_);
       for (size_t i = 0; i < rule_.nodes.size(); ++i) {
         const double rho = rule_.nodes[i];
-        algebra::axpby(1.0 - rho, y, rho, x, stage_);
-        problem_.nonlinear(t + rho * h_, stage_, n_);
+        algebra::axpby(1.0 - rho, y, rho, x, out);
+        problem_.nonlinear(t + rho * h_, out, n_);
         algebra::axpy(rule_.weights[i], n_, average_);
       }
-      algebra::diagonal_multiply_add(base_, b_, average_, out);
+      algebra::diagonal_combination(e_, y, b_, average_, out);
     });
     algebra::copy(next_, y);
     guess_.stored();
   }
 
   tsi::SolverStats stats() const override { return solver_->stats(); }
-  double state_vectors() const override { return 7.0 + solver_->state_vectors(); }
+  double state_vectors() const override { return state_vectors_for(problem_.layout(), {options_, 0}); }
+  // Two coefficients, the iterate, N at a quadrature point, the average, the solver's.
+  static double state_vectors_for(const tsi::ProblemLayout& layout, const Settings& settings) {
+    return 2.0 * layout.diagonal_fraction() + 3.0 + tsi::fixed_point_state_vectors(settings.options);
+  }
 
  private:
   std::unique_ptr<tsi::FixedPointSolver> solver_;
   tsi::StageGuess guess_;
   tsi::QuadratureRule rule_;
-  Vector e_, b_;  // the coefficients of step size h
-  Vector base_, next_, stage_, n_, average_;
+  tsi::FixedPointOptions options_;
+  tsi::Diagonal e_, b_;  // the coefficients of step size h
+  Vector next_, n_, average_;
 };
 
 void register_se2(tsi::Registry& registry) {

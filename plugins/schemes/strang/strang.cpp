@@ -22,6 +22,7 @@ class Strang final : public tsi::Stepper {
   }
 
   double state_vectors() const override { return 0.0; }
+  static double state_vectors_for(const tsi::ProblemLayout&, std::monostate) { return 0.0; }
 };
 
 void register_strang(tsi::Registry& registry) {
