@@ -5,6 +5,9 @@
 //                          evaluations of N per step)
 //   step_eps/<model>/se1/<eps>  the same at eps = 1 and 1e-6: the cost must not depend on eps
 //   nonlinearity_threads/<model>/2  the nonlinearity with FFTW on two threads (large NLS grids)
+//   large/<case>/{nonlinearity,fft_bound,se1,eab}  the same at the sizes where the state
+//                          dominates: NLS n_x = 8192 x n_tau 64 (complex), the synthetic real
+//                          Henon-Heiles ensemble with 2^18 copies x n_tau 16 (the real layout)
 //   tau_threads/<model>_ntau<M>/<T> one SE1 step (h = 1/8, eps = 0.01) with the tau grid split
 //                                   over T threads (tsi --threads): Henon-Heiles and the charged
 //                                   particle (4 x 64), NLS and Klein-Gordon n_x = 16 ... 1024
@@ -17,6 +20,7 @@
 
 #include "tsi/assembly.hpp"
 #include "tsi/fft.hpp"
+#include "tsi/real_fft.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/plugin_loader.hpp"
 #include "tsi/registry.hpp"
@@ -34,7 +38,9 @@ tsi::Registry& registry() {
   static tsi::Registry r;
   static const bool loaded = [] {
     tsi::register_core(r);
-    tsi::PluginLoader(r).load_directory(TSI_BENCH_PLUGIN_DIR);
+    tsi::PluginLoader loader(r);
+    loader.load_directory(TSI_BENCH_PLUGIN_DIR);
+    loader.load_directory(TSI_BENCH_MODEL_DIR);  // the synthetic models of the scale cases
     return true;
   }();
   (void)loaded;
@@ -75,6 +81,19 @@ void nonlinearity_threads(benchmark::State& state, Case c, int threads) {
 
 void fft_bound(benchmark::State& state, Case c) {
   auto model = make_model(c, 0.01);
+  if (!model->is_complex() && !model->has_linear_remainder() && model->dim() > 4) {
+    // A large real model: the real layout's transforms, tau modes 0 .. n_tau/2.
+    const int rows = static_cast<int>(model->dim());
+    tsi::RealFftBatch tau(c.n_tau, rows);
+    tsi::RealMatrix values = tsi::RealMatrix::Random(rows, c.n_tau);
+    tsi::Matrix coefficients(rows, c.n_tau / 2 + 1);
+    for (auto _ : state) {
+      tau.forward_unnormalised(values.data(), coefficients.data());
+      tau.backward(coefficients.data(), values.data());
+      benchmark::DoNotOptimize(values.data());
+    }
+    return;
+  }
   // The model's own transforms (NLS: in x) happen inside its field; count the tau ones here,
   // and x ones by a second batch of the same size when the model is a field (complex, dim > 4).
   tsi::FftBatch tau(c.n_tau, static_cast<int>(model->dim()));
@@ -142,6 +161,7 @@ std::vector<Case> paper_cases() {
 }
 
 std::string label(const Case& c) {
+  if (c.model_params.contains("copies")) return c.model + "_" + c.model_params["copies"].dump();
   return c.model_params.contains("n_x") ? c.model + "_nx" + c.model_params["n_x"].dump() : c.model;
 }
 
@@ -169,6 +189,13 @@ int main(int argc, char** argv) {
     for (double eps : {1.0, 1e-6})
       benchmark::RegisterBenchmark(("step_eps/" + label(c) + "/se1/" + (eps == 1.0 ? "1" : "1e-6")).c_str(), step, c,
                                    tsi::Json{{"name", "se1"}}, eps);
+  }
+  for (const Case& c : {Case{"nls", {{"n_x", 8192}}, 64}, Case{"henon-heiles-ensemble", {{"copies", 262144}}, 16}}) {
+    const std::string prefix = "large/" + label(c) + "_ntau" + std::to_string(c.n_tau) + "/";
+    benchmark::RegisterBenchmark((prefix + "nonlinearity").c_str(), nonlinearity, c);
+    benchmark::RegisterBenchmark((prefix + "fft_bound").c_str(), fft_bound, c);
+    for (const char* scheme : {"se1", "eab"})
+      benchmark::RegisterBenchmark((prefix + scheme).c_str(), step, c, tsi::Json{{"name", scheme}}, 0.01);
   }
   std::vector<Case> threaded = {{"henon-heiles", tsi::Json::object(), 64}, {"cpd", tsi::Json::object(), 64},
                                  {"nls", {{"n_x", 16}}, 32}, {"nls", {{"n_x", 16}}, 64}};

@@ -4,6 +4,8 @@
 # problem with SE1 and eab, STEPS steps, no reference; peak memory and wall time per step from
 # each run's result.json. Numbers for the README and docs/scaling.md.
 #   bench/large_real.sh [COPIES] [N_TAU] [STEPS] [OUT]
+# SCHEMES (default "se1 eab") and LAYOUTS (default "true false": reformulation.real_layout)
+# select the runs.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 copies="${1:-2500000}"
@@ -13,8 +15,8 @@ out="${4:-$root/out/large-real}"
 tsi="$root/build/bin/tsi"
 plugin="$root/build/lib/tsi/bench-plugins/tsi_henon_heiles_ensemble.so"
 mkdir -p "$out"
-for scheme in se1 eab; do
-  for layout in true false; do
+for scheme in ${SCHEMES:-se1 eab}; do
+  for layout in ${LAYOUTS:-true false}; do
     name="$scheme-real_layout-$layout"
     cat >"$out/$name.json" <<JSON
 {
