@@ -63,7 +63,8 @@ def step_table(bench):
     for name, b in bench.items():
         if not name.startswith("step/"):
             continue
-        _, model, scheme = name.split("/")
+        # step/<model>/<scheme>[/<variant>] (step/cpd/se2/2-nodes)
+        _, model, scheme = name.split("/", 2)
         fft = bench[f"fft_bound/{model}"]["real_time"]
         sweeps, evaluations = b.get("sweeps", 0.0), b.get("evaluations", 0.0)
         units = sweeps if sweeps else evaluations  # sweeps of an implicit scheme, else evaluations
@@ -80,6 +81,20 @@ def step_table(bench):
             model = name.split("/")[1]
             fft = bench[f"fft_bound/{model}"]["real_time"]
             lines.append(f"    {model:<20}{b['real_time']:>10.0f} ns  bound {fft:>8.0f} ns  ratio {b['real_time'] / fft:.2f}")
+    lines.append("  at sizes where the state dominates (large/<case>): N and a step against the transforms:")
+    for name, b in bench.items():
+        if name.startswith("large/") and name.endswith("/fft_bound"):
+            case = name.split("/")[1]
+            fft = b["real_time"]
+            n = bench.get(f"large/{case}/nonlinearity")
+            if n:
+                lines.append(f"    {case:<36} N {n['real_time']:>12.0f} ns  bound {fft:>12.0f} ns  ratio {n['real_time'] / fft:.2f}")
+            for scheme in ("se1", "eab"):
+                st = bench.get(f"large/{case}/{scheme}")
+                if st and st.get("evaluations"):
+                    ratio = st["real_time"] / (st["evaluations"] * fft)
+                    lines.append(f"    {case:<36} {scheme} step {st['real_time']:>12.0f} ns  {st['evaluations']:.1f} evaluations"
+                                 f"  step / (evaluations x bound) {ratio:.2f}")
     lines.append("  the same with FFTW on two threads (tsi --fft-threads 2; used from 65536 values per batch):")
     for name, b in bench.items():
         if name.startswith("nonlinearity_threads/"):
