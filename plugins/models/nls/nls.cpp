@@ -79,7 +79,7 @@ class Nls final : public tsi::Model {
 
   void filtered_field(const tsi::RealVector& taus, MatrixRef c, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    fused_field(taus, batch(slice(c.cols())), c, out);
+    fused_field(taus, nullptr, batch(slice(c.cols())), c, out);
   }
 
   // A run's tau grid: its phases, and transforms of its own for a slice of the grid's columns
@@ -88,13 +88,22 @@ class Nls final : public tsi::Model {
   class GridField final : public tsi::TauGridField {
    public:
     GridField(const Nls& model, const tsi::RealVector& taus)
-        : model_(model), taus_(taus), batch_(model.n_x_, model.slice(taus.size())) {}
-    void evaluate(MatrixRef c, MatrixRef out) override { model_.fused_field(taus_, batch_, c, out); }
+        : model_(model), taus_(taus), batch_(model.n_x_, model.slice(taus.size())) {
+      // A small grid keeps its phases in a table (read, not recomputed: 15% of a step at
+      // n_x = 16, n_tau = 256); a large one computes them as it goes (no table of half the
+      // state's size).
+      if ((model.n_x_ / 2 + 1) * taus.size() <= max_phase_table) phase_ = phase_table(taus, model.n_x_);
+    }
+    void evaluate(MatrixRef c, MatrixRef out) override {
+      model_.fused_field(taus_, phase_.size() ? &phase_ : nullptr, batch_, c, out);
+    }
     bool in_place() const override { return true; }
 
    private:
+    static constexpr Index max_phase_table = Index{1} << 15;  // 512 kB
     const Nls& model_;
     tsi::RealVector taus_;
+    tsi::Matrix phase_;
     tsi::GridFft batch_;
   };
 
@@ -110,17 +119,19 @@ class Nls final : public tsi::Model {
   // The phases come from phase_table's recurrence, column by column as they are needed (the
   // same products: no table of the state's half size). A slice of b.columns() columns at a
   // time, each read before it is written: out may be c.
-  void fused_field(const tsi::RealVector& taus, tsi::GridFft& b, MatrixRef c, MatrixRef out) const {
+  // With `phase` (phase_table's values for taus), the phases are read from it instead.
+  void fused_field(const tsi::RealVector& taus, const tsi::Matrix* phase, tsi::GridFft& b, MatrixRef c,
+                   MatrixRef out) const {
     const int half = n_x_ / 2;
     const double scale = 1.0 / (tsi::two_pi * n_x_);
     for (Index j0 = 0; j0 < c.cols(); j0 += b.columns()) {
       const Index k = std::min(b.columns(), c.cols() - j0);
       auto w = b.data();  // row j: state j0 + j
       for (Index j = 0; j < k; ++j) {
-        PhaseRecurrence phase(taus(j0 + j));
+        PhaseRecurrence recurrence(taus(j0 + j));
         w(j, 0) = c(0, j0 + j);
         for (int m = 1; m <= half; ++m) {
-          const Complex e = phase.next();
+          const Complex e = phase ? (*phase)(m, j0 + j) : recurrence.next();
           w(j, m) = times(c(m, j0 + j), e);
           if (n_x_ - m != m) w(j, n_x_ - m) = times(c(n_x_ - m, j0 + j), e);
         }
@@ -135,10 +146,10 @@ class Nls final : public tsi::Model {
       }
       b.forward();
       for (Index j = 0; j < k; ++j) {
-        PhaseRecurrence phase(taus(j0 + j));
+        PhaseRecurrence recurrence(taus(j0 + j));
         out(0, j0 + j) = w(j, 0);
         for (int m = 1; m <= half; ++m) {
-          const Complex e = phase.next();
+          const Complex e = phase ? (*phase)(m, j0 + j) : recurrence.next();
           out(m, j0 + j) = times_conj(w(j, m), e);
           if (n_x_ - m != m) out(n_x_ - m, j0 + j) = times_conj(w(j, n_x_ - m), e);
         }
