@@ -119,22 +119,32 @@ class Nls final : public tsi::Model {
   // The phases come from phase_table's recurrence, column by column as they are needed (the
   // same products: no table of the state's half size). A slice of b.columns() columns at a
   // time, each read before it is written: out may be c.
+  // use(m, e^{-i m^2 tau}) for m = 1 .. N_x/2: from column `col` of `phase` (phase_table's
+  // values) where there is one, else by the recurrence (no sincos per column with a table).
+  template <class Use>
+  void for_each_phase(double tau, const tsi::Matrix* phase, Index col, Use&& use) const {
+    const int half = n_x_ / 2;
+    if (phase) {
+      for (int m = 1; m <= half; ++m) use(m, (*phase)(m, col));
+      return;
+    }
+    PhaseRecurrence recurrence(tau);
+    for (int m = 1; m <= half; ++m) use(m, recurrence.next());
+  }
+
   // With `phase` (phase_table's values for taus), the phases are read from it instead.
   void fused_field(const tsi::RealVector& taus, const tsi::Matrix* phase, tsi::GridFft& b, MatrixRef c,
                    MatrixRef out) const {
-    const int half = n_x_ / 2;
     const double scale = 1.0 / (tsi::two_pi * n_x_);
     for (Index j0 = 0; j0 < c.cols(); j0 += b.columns()) {
       const Index k = std::min(b.columns(), c.cols() - j0);
       auto w = b.data();  // row j: state j0 + j
       for (Index j = 0; j < k; ++j) {
-        PhaseRecurrence recurrence(taus(j0 + j));
         w(j, 0) = c(0, j0 + j);
-        for (int m = 1; m <= half; ++m) {
-          const Complex e = phase ? (*phase)(m, j0 + j) : recurrence.next();
+        for_each_phase(taus(j0 + j), phase, j0 + j, [&](int m, Complex e) {
           w(j, m) = times(c(m, j0 + j), e);
           if (n_x_ - m != m) w(j, n_x_ - m) = times(c(n_x_ - m, j0 + j), e);
-        }
+        });
       }
       if (k < w.rows()) w.bottomRows(w.rows() - k).setZero();
       b.backward();
@@ -146,13 +156,11 @@ class Nls final : public tsi::Model {
       }
       b.forward();
       for (Index j = 0; j < k; ++j) {
-        PhaseRecurrence recurrence(taus(j0 + j));
         out(0, j0 + j) = w(j, 0);
-        for (int m = 1; m <= half; ++m) {
-          const Complex e = phase ? (*phase)(m, j0 + j) : recurrence.next();
+        for_each_phase(taus(j0 + j), phase, j0 + j, [&](int m, Complex e) {
           out(m, j0 + j) = times_conj(w(j, m), e);
           if (n_x_ - m != m) out(n_x_ - m, j0 + j) = times_conj(w(j, n_x_ - m), e);
-        }
+        });
       }
     }
   }
