@@ -257,7 +257,9 @@ class MatrixModel final : public Model {
   // The time of every column: its last entry when the model carries t, else 0.
   RealVector times(ConstMatrixRef states) const {
     if (!time_) return RealVector::Zero(states.cols());
-    return states.row(d_).real().transpose();
+    RealVector t(states.cols());  // entry by entry: Eigen's debug aliasing check cannot take a view of a view here
+    for (Index j = 0; j < states.cols(); ++j) t(j) = states(d_, j).real();
+    return t;
   }
 
   PeriodicMatrixFlow flow_;
