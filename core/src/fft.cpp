@@ -181,52 +181,23 @@ void FftBatch::transform(const Complex* from, Complex* to, int direction, double
   }
 }
 
-void FftBatch::transform_rows(int first, int count, int direction, int part) {
-  if (blocks_.empty()) {
-    const bool whole = part < 0 || part_plans_.empty();
-    fftw_execute(as_plan(whole ? plans_[direction] : part_plans_[2 * static_cast<std::size_t>(part) + direction]));
-    return;
-  }
-  // Rows r .. r + k - 1 into the block, transposed (each row's n points contiguous), and back.
-  Complex* b = blocks_[part < 0 ? 0 : static_cast<std::size_t>(part)];
-  buffer();
-  const std::size_t stride = static_cast<std::size_t>(howmany_);
-  for (int r = first; r < first + count; r += block_rows) {
-    const int k = std::min(block_rows, first + count - r);
-    const Complex* from = buffer_ + r;
-    for (int j = 0; j < n_; ++j)
-      for (int i = 0; i < k; ++i) b[static_cast<std::size_t>(i) * n_ + j] = from[j * stride + i];
-    if (k == block_rows) {
-      fftw_execute_dft(as_plan(block_plans_[direction]), raw(b), raw(b));
-    } else {
-      for (int i = 0; i < k; ++i) {
-        Complex* row = b + static_cast<std::size_t>(i) * n_;
-        fftw_execute_dft(as_plan(row_plans_[direction]), raw(row), raw(row));
-      }
-    }
-    Complex* to = buffer_ + r;
-    for (int j = 0; j < n_; ++j)
-      for (int i = 0; i < k; ++i) to[j * stride + i] = b[static_cast<std::size_t>(i) * n_ + j];
-  }
-}
-
 void FftBatch::forward() {
   forward_unnormalised();
   data() *= 1.0 / n_;
 }
 
-void FftBatch::forward_unnormalised() { transform_rows(0, howmany_, 0, -1); }
+// The buffer's own transforms: transform() from the buffer into itself (allocated first).
+void FftBatch::forward_unnormalised() { buffer_transform(0, -1); }
 
-void FftBatch::backward() { transform_rows(0, howmany_, 1, -1); }
+void FftBatch::backward() { buffer_transform(1, -1); }
 
-void FftBatch::forward_part(int p) {
-  const auto i = static_cast<std::size_t>(p);
-  transform_rows(part_rows_[i], part_rows_[i + 1] - part_rows_[i], 0, p);
-}
+void FftBatch::forward_part(int p) { buffer_transform(0, p); }
 
-void FftBatch::backward_part(int p) {
-  const auto i = static_cast<std::size_t>(p);
-  transform_rows(part_rows_[i], part_rows_[i + 1] - part_rows_[i], 1, p);
+void FftBatch::backward_part(int p) { buffer_transform(1, p); }
+
+void FftBatch::buffer_transform(int direction, int part) {
+  Complex* b = buffer();
+  transform(b, b, direction, 1.0, nullptr, part);
 }
 
 }  // namespace tsi

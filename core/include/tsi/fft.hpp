@@ -61,11 +61,10 @@ class TSI_API FftBatch {
   bool buffered() const { return !blocks_.empty(); }
 
  private:
-  /// Transforms rows [first, first + count) of the buffer (direction 0 forward, 1 backward)
-  /// for part `part` (-1: the whole batch): strided, or through that part's block.
-  void transform_rows(int first, int count, int direction, int part);
   /// The buffer, allocated (and zeroed) on first use.
   Complex* buffer();
+  /// transform() of the buffer's rows (part `part`, -1: all) into itself.
+  void buffer_transform(int direction, int part);
   void release();
 
   int n_, howmany_;

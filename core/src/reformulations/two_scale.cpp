@@ -191,6 +191,18 @@ void TwoScale::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vec
   Eigen::Map<Matrix> grid(out.data(), dim_, n_tau_);
   Complex* field = in_place ? out.data() : field_.data();
   const Complex* shift = mean_shift ? mean_shift->data() : nullptr;
+  on_grid_threads([&](int p) { fft_->transform(y.data(), out.data(), 1, 1.0, shift, p); },
+                  [&](int p, Index c0, Index cn) {
+                    if (in_place)
+                      column_fields_[p]->evaluate(grid.middleCols(c0, cn), grid.middleCols(c0, cn));
+                    else
+                      column_fields_[p]->evaluate(grid.middleCols(c0, cn), field_.middleCols(c0, cn));
+                  },
+                  [&](int p) { fft_->transform(field, out.data(), 0, 1.0 / n_tau_, nullptr, p); });
+}
+
+template <class In, class Field, class Out>
+void TwoScale::on_grid_threads(In&& transform_in, Field&& evaluate, Out&& transform_out) {
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads_));
   // Transforms go by rows, the field by columns; every phase reads what the one before wrote
   // on other threads, hence the barriers. A team smaller than asked for (an OpenMP limit)
@@ -199,23 +211,17 @@ void TwoScale::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vec
 #pragma omp parallel num_threads(threads_)
 #endif
   {
-    const auto parts = [&](auto&& work) {
-      for (int p = thread_index(); p < threads_; p += team_size()) work(p, column_begin_[p], column_begin_[p + 1] - column_begin_[p]);
-    };
-    parts([&](int p, Index, Index) { fft_->transform(y.data(), out.data(), 1, 1.0, shift, p); });
+    for (int p = thread_index(); p < threads_; p += team_size()) transform_in(p);
     barrier();
-    parts([&](int p, Index c0, Index cn) {
+    for (int p = thread_index(); p < threads_; p += team_size()) {
       try {
-        if (in_place)
-          column_fields_[p]->evaluate(grid.middleCols(c0, cn), grid.middleCols(c0, cn));
-        else
-          column_fields_[p]->evaluate(grid.middleCols(c0, cn), field_.middleCols(c0, cn));
+        evaluate(p, column_begin_[p], column_begin_[p + 1] - column_begin_[p]);
       } catch (...) {
         errors[p] = std::current_exception();
       }
-    });
+    }
     barrier();
-    parts([&](int p, Index, Index) { fft_->transform(field, out.data(), 0, 1.0 / n_tau_, nullptr, p); });
+    for (int p = thread_index(); p < threads_; p += team_size()) transform_out(p);
   }
   for (const auto& error : errors)
     if (error) std::rethrow_exception(error);
@@ -241,33 +247,12 @@ void TwoScale::nonlinear_real(const Vector& y, const Vector* mean_shift, Vector&
     out *= scale;
     return;
   }
-  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads_));
-  // As nonlinear_threaded: transforms by rows, the field by columns, barriers between.
-#if defined(_OPENMP)
-#pragma omp parallel num_threads(threads_)
-#endif
-  {
-    const auto parts = [&](auto&& work) {
-      for (int p = thread_index(); p < threads_; p += team_size()) work(p, column_begin_[p], column_begin_[p + 1] - column_begin_[p]);
-    };
-    parts([&](int p, Index, Index) { transform_in(p); });
-    barrier();
-    parts([&](int p, Index c0, Index cn) {
-      try {
-        evaluate_real_grid(*column_fields_[p], c0, cn);
-      } catch (...) {
-        errors[p] = std::current_exception();
-      }
-    });
-    barrier();
-    parts([&](int p, Index, Index) {
-      real_fft_->forward_unnormalised(field, out.data(), p);
-      const Index r0 = real_fft_->part_begin(p), rn = real_fft_->part_begin(p + 1) - r0;
-      Eigen::Map<Matrix>(out.data(), dim_, columns_).middleRows(r0, rn) *= scale;
-    });
-  }
-  for (const auto& error : errors)
-    if (error) std::rethrow_exception(error);
+  on_grid_threads(transform_in, [&](int p, Index c0, Index cn) { evaluate_real_grid(*column_fields_[p], c0, cn); },
+                  [&](int p) {
+                    real_fft_->forward_unnormalised(field, out.data(), p);
+                    const Index r0 = real_fft_->part_begin(p), rn = real_fft_->part_begin(p + 1) - r0;
+                    Eigen::Map<Matrix>(out.data(), dim_, columns_).middleRows(r0, rn) *= scale;
+                  });
 }
 
 void TwoScale::evaluate_real_grid(TauGridField& field, Index c0, Index cn) {

@@ -106,6 +106,11 @@ class TwoScale final : public Reformulation {
   void evaluate_real_grid(TauGridField& field, Index c0, Index cn);
   /// nonlinear_shifted in the real layout.
   void nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& out);
+  /// A field evaluation on threads_ threads: transform_in(p) and transform_out(p) on part p's
+  /// rows, evaluate(p, c0, cn) on its columns [c0, c0 + cn), with barriers between; an
+  /// exception from evaluate reaches the caller once every thread has finished.
+  template <class In, class Field, class Out>
+  void on_grid_threads(In&& transform_in, Field&& evaluate, Out&& transform_out);
   /// A = (d/dtau)^{-1} (I - Pi) on coefficients: mode k / (i k), modes 0 and Nyquist to 0.
   Matrix apply_A(Matrix c) const;
   /// A's multiplier on the Fourier index j: 1 / (i k), 0 on modes 0 and Nyquist.
