@@ -14,6 +14,12 @@ struct TSI_API ProblemLayout {
   double diagonal_fraction() const {
     return size > 0 ? static_cast<double>(diagonal_values) / static_cast<double>(size) : 1.0;
   }
+  /// Unknowns up to which an implicit scheme keeps its stage's base e^{cz} y (one vector more,
+  /// at most 1 MB): each sweep then adds to it instead of forming it again, a stream fewer per
+  /// sweep (3% of an SE1 step at NLS n_x = 16, n_tau = 256). Larger states form it in each
+  /// sweep's pass, the same products rounded the same way, and save the vector.
+  static constexpr Index max_stored_base = Index{1} << 16;
+  bool stores_stage_bases() const { return size <= max_stored_base; }
 };
 
 /// The problem a stepper integrates:  y' = L y + N(t, y).

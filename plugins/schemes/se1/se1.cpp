@@ -37,12 +37,14 @@ class Se1 final : public tsi::Stepper {
         solver_(tsi::make_fixed_point_solver(options)),
         guess_(options),
         y_half_(problem.new_state()),
-        n_half_(problem.new_state()) {}
+        n_half_(problem.new_state()),
+        base_(problem.layout().stores_stage_bases() ? problem.new_state() : Vector()) {}
 
   void reset() override { guess_.reset(); }
 
-  // The stage's base e^{z/2} U^n is not stored: each sweep forms it again in the same pass
-  // (the same products, rounded the same way), one vector less than a stored base.
+  // The stage's base e^{z/2} U^n is stored for small states only (ProblemLayout::
+  // stores_stage_bases); otherwise each sweep forms it again in the same pass (the same
+  // products, rounded the same way), one vector less.
   void step(double t, Vector& y) override {
     // Starting guess: the stage with the previous step's N(U^{n-1/2}), an O(h^2) predictor.
     if (guess_.from_previous())
@@ -50,10 +52,18 @@ class Se1 final : public tsi::Stepper {
     else
       algebra::diagonal_multiply(c_.e_half, y, y_half_);
     const double t_half = t + 0.5 * h_;
-    solver_->solve(y_half_, [&](const Vector& x, Vector& out) {
-      problem_.nonlinear(t_half, x, n_half_);
-      algebra::diagonal_combination(c_.e_half, y, c_.b_half, n_half_, out);
-    });
+    if (base_.size()) {
+      algebra::diagonal_multiply(c_.e_half, y, base_);
+      solver_->solve(y_half_, [&](const Vector& x, Vector& out) {
+        problem_.nonlinear(t_half, x, n_half_);
+        algebra::diagonal_multiply_add(base_, c_.b_half, n_half_, out);
+      });
+    } else {
+      solver_->solve(y_half_, [&](const Vector& x, Vector& out) {
+        problem_.nonlinear(t_half, x, n_half_);
+        algebra::diagonal_combination(c_.e_half, y, c_.b_half, n_half_, out);
+      });
+    }
     // n_half_ = N at the last-but-one iterate, within tol of N(U^{n+1/2}).
     algebra::diagonal_combination(c_.e_full, y, c_.b_full, n_half_, y);
     guess_.stored();
@@ -61,9 +71,10 @@ class Se1 final : public tsi::Stepper {
 
   tsi::SolverStats stats() const override { return solver_->stats(); }
   double state_vectors() const override { return state_vectors_for(problem_.layout(), options_); }
-  // Four coefficients, the stage and its N, and the solver's work space.
+  // Four coefficients, the stage and its N (and its base, small states), and the solver's work space.
   static double state_vectors_for(const tsi::ProblemLayout& layout, const tsi::FixedPointOptions& options) {
-    return 4.0 * layout.diagonal_fraction() + 2.0 + tsi::fixed_point_state_vectors(options);
+    return 4.0 * layout.diagonal_fraction() + (layout.stores_stage_bases() ? 3.0 : 2.0) +
+           tsi::fixed_point_state_vectors(options);
   }
 
  private:
@@ -72,6 +83,7 @@ class Se1 final : public tsi::Stepper {
   tsi::StageGuess guess_;
   tsi::FixedPointOptions options_ = solver_->options();
   Vector y_half_, n_half_;
+  Vector base_;  // e^{z/2} U^n where the state is small (empty otherwise)
 };
 
 void register_se1(tsi::Registry& registry) {
