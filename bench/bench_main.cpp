@@ -24,7 +24,7 @@
 #include "tsi/phase.hpp"
 #include "tsi/plugin_loader.hpp"
 #include "tsi/registry.hpp"
-#include "tsi/tau_grid_threads.hpp"
+#include "tsi/context.hpp"
 
 namespace {
 
@@ -47,22 +47,25 @@ tsi::Registry& registry() {
   return r;
 }
 
-std::shared_ptr<const tsi::Model> make_model(const Case& c, double eps) {
+std::shared_ptr<const tsi::Model> make_model(const Case& c, double eps, const tsi::Context& context = {}) {
   const auto& e = registry().model(c.model);
   tsi::Json params = c.model_params;
   params["eps"] = eps;
-  return e.create(tsi::Params(tsi::resolve_params(e.info.params, params, "model")));
+  return e.create(tsi::Params(tsi::resolve_params(e.info.params, params, "model"), context));
 }
 
-std::unique_ptr<tsi::Reformulation> two_scale(std::shared_ptr<const tsi::Model> model, const Case& c, int order) {
+std::unique_ptr<tsi::Reformulation> two_scale(std::shared_ptr<const tsi::Model> model, const Case& c, int order,
+                                              const tsi::Context& context = {}) {
   const auto& e = registry().reformulation("two-scale");
-  return e.create(std::move(model), tsi::Params(tsi::resolve_params(
-                                        e.info.params, {{"n_tau", c.n_tau}, {"initial_data_order", order}}, "bench")));
+  return e.create(std::move(model),
+                  tsi::Params(tsi::resolve_params(e.info.params, {{"n_tau", c.n_tau}, {"initial_data_order", order}},
+                                                  "bench"),
+                              context));
 }
 
-void nonlinearity(benchmark::State& state, Case c) {
-  auto model = make_model(c, 0.01);
-  auto problem = two_scale(model, c, 2);
+void nonlinearity_in(benchmark::State& state, const Case& c, const tsi::Context& context) {
+  auto model = make_model(c, 0.01, context);
+  auto problem = two_scale(model, c, 2, context);
   const tsi::Vector y = problem->prepare(model->initial_value());
   tsi::Vector out(y.size());
   for (auto _ : state) {
@@ -72,11 +75,13 @@ void nonlinearity(benchmark::State& state, Case c) {
   state.counters["unknowns"] = static_cast<double>(y.size());
 }
 
-// The same with FFTW splitting each large batch over `threads` threads (set_fft_threads).
+void nonlinearity(benchmark::State& state, Case c) { nonlinearity_in(state, c, {}); }
+
+// The same with FFTW splitting each large batch over `threads` threads (Context::fft).
 void nonlinearity_threads(benchmark::State& state, Case c, int threads) {
-  tsi::set_fft_threads(threads);
-  nonlinearity(state, c);
-  tsi::set_fft_threads(1);
+  tsi::Context context;
+  context.fft.threads = threads;
+  nonlinearity_in(state, c, context);
 }
 
 void fft_bound(benchmark::State& state, Case c) {
@@ -112,15 +117,17 @@ void fft_bound(benchmark::State& state, Case c) {
   }
 }
 
-void step(benchmark::State& state, Case c, tsi::Json scheme, double eps) {
+void step_in(benchmark::State& state, const Case& c, const tsi::Json& scheme, double eps, const tsi::Context& context) {
   // The runner's assembler: every default completed as `tsi run` completes it (SE2's nodes).
+  tsi::AssemblyOptions options;
+  options.context = context;
   tsi::Json model_section = c.model_params;
   model_section["name"] = c.model;
   model_section["eps"] = eps;
   tsi::Assembly a = tsi::assemble_config({{"model", model_section},
                                           {"reformulation", {{"name", "two-scale"}, {"n_tau", c.n_tau}}},
                                           {"scheme", scheme}},
-                                         registry());
+                                         registry(), options);
   tsi::Reformulation* problem = a.reformulation.get();
   const double h = 0.125;
   tsi::Stepper* stepper = &a.bind(h);
@@ -142,11 +149,13 @@ void step(benchmark::State& state, Case c, tsi::Json scheme, double eps) {
   state.counters["evaluations"] = static_cast<double>(problem->evaluations()) / static_cast<double>(state.iterations());
 }
 
+void step(benchmark::State& state, Case c, tsi::Json scheme, double eps) { step_in(state, c, scheme, eps, {}); }
+
 // One step with the tau grid on `threads` threads from the first size (threshold 1).
 void step_tau_threads(benchmark::State& state, Case c, int threads) {
-  tsi::set_tau_grid_threads(threads, 1);
-  step(state, c, tsi::Json{{"name", "se1"}}, 0.01);
-  tsi::set_tau_grid_threads(1);
+  tsi::Context context;
+  context.tau_grid = {threads, 1};
+  step_in(state, c, tsi::Json{{"name", "se1"}}, 0.01, context);
 }
 
 std::vector<Case> paper_cases() {

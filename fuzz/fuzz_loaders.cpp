@@ -21,10 +21,10 @@ namespace {
 
 tsi::Registry& registry() {
   static tsi::Registry& r = [] () -> tsi::Registry& {
-    tsi::Registry& global = tsi::Registry::global();
-    static tsi::PluginLoader loader(global);
-    tsi::app::load_plugins(loader, global, {});
-    return global;
+    static tsi::Registry registry;
+    static tsi::PluginLoader loader(registry);
+    tsi::app::load_plugins(loader, registry, {});
+    return registry;
   }();
   return r;
 }

@@ -28,7 +28,7 @@
 #include "summary.hpp"
 #include "tsi/error.hpp"
 #include "tsi/fft.hpp"
-#include "tsi/tau_grid_threads.hpp"
+#include "tsi/context.hpp"
 #include "tsi/version.hpp"
 
 namespace {
@@ -36,7 +36,7 @@ namespace {
 using tsi::Json;
 
 int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::string& config_path,
-                std::string out_dir, const std::vector<std::string>& overrides) {
+                std::string out_dir, const std::vector<std::string>& overrides, const tsi::app::RunSettings& settings) {
   Json raw = tsi::app::load_config_file(config_path);
   for (const auto& assignment : overrides) tsi::app::apply_override(raw, assignment);
   tsi::app::resolve_config_files(raw, config_path);  // model.u0 as a file: relative to the config, as plugins
@@ -45,7 +45,7 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
   const Json config = tsi::app::resolve_run_config(raw, registry);
   // Too many steps are refused before --out is touched; the reference's cost after the run's
   // own objects are checked (their memory first), still before anything is computed.
-  tsi::app::check_run_steps(config);
+  tsi::app::check_run_steps(config, settings.max_steps);
   if (out_dir.empty()) out_dir = "out/" + std::filesystem::path(config_path).stem().string();
   tsi::app::prepare_output_dir(out_dir);
 
@@ -65,7 +65,7 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
     else
       fmt::print(stderr, "\r  {}: {:5.1f}%", what, 100.0 * fraction);
   };
-  const tsi::app::RunOutcome outcome = tsi::app::execute_run(config, registry, progress, nullptr, out_dir);
+  const tsi::app::RunOutcome outcome = tsi::app::execute_run(config, registry, settings, progress, nullptr, out_dir);
   if (tty) fmt::print(stderr, "\r{:80}\r", "");
   tsi::app::write_run_files(out_dir, outcome);  // IoError (exit 3) when result.json cannot be written
   fmt::print("{}", tsi::app::run_summary(outcome, out_dir));
@@ -172,10 +172,12 @@ int main(int argc, char** argv) {
   if (run->parsed() || study->parsed()) tsi::app::install_interrupt_handlers();
 
   try {
-    tsi::set_fft_threads(fft_threads, 65536);
+    // The run's settings, built once from the flags and passed down (nothing process wide):
+    // a run's tau grid on every core unless --threads says otherwise, a study's runs on one each.
     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    tsi::set_tau_grid_threads(threads > 0 ? threads : run->parsed() ? cores : 1);
-    tsi::Registry& registry = tsi::Registry::global();
+    const tsi::app::RunSettings settings =
+        tsi::app::RunSettings::from_flags(threads > 0 ? threads : run->parsed() ? cores : 1, fft_threads, max_steps);
+    tsi::Registry registry;
     tsi::PluginLoader loader(registry);
     for (const auto& warning : tsi::app::load_plugins(loader, registry, plugin_files))
       spdlog::warn("plugin not loaded: {}", warning);
@@ -194,11 +196,11 @@ int main(int argc, char** argv) {
       check_options.model_params = model_overrides["model"];
       return tsi::app::check_command(loader, registry, check_options, plugin_files);
     }
-    tsi::app::set_max_steps(max_steps);
     const int rc = study->parsed()
                        ? tsi::app::study_entry(loader, registry,
-                                               {study_path, study_out, jobs, study_overrides, !no_plots, shard, merge_dirs, resume, force})
-                       : run_command(loader, registry, config_path, out_dir, overrides);
+                                               {study_path, study_out, jobs, study_overrides, !no_plots, shard, merge_dirs, resume, force,
+                                                settings})
+                       : run_command(loader, registry, config_path, out_dir, overrides, settings);
     if (tsi::app::interrupted() && rc != 3) {  // an output that failed is said first
       spdlog::error("interrupted by signal {}: what was computed is written", tsi::app::interrupt_signal());
       return 128 + tsi::app::interrupt_signal();

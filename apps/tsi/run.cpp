@@ -48,19 +48,21 @@ namespace {
 
 // The reference's objects, through the same assembler as the run's (a two-scale reference gets
 // the model's own tau resolution and the data its scheme needs).
-Assembly reference_assembly(const Json& config, const Registry& registry, const Json& scheme_section) {
+Assembly reference_assembly(const Json& config, const Registry& registry, const Json& scheme_section,
+                            const RunSettings& settings) {
+  AssemblyOptions options;
+  options.context = settings.context;
   return assemble_config({{"model", config["model"]},
                           {"reformulation", {{"name", config["reference"]["reformulation"]}}},
                           {"scheme", scheme_section}},
-                         registry);
+                         registry, options);
 }
 
 // What the reference will cost, refused before it starts when it would exceed --max-steps: an
 // adaptive solver takes at least substeps_per_period steps per fastest period of the problem.
-void check_reference_cost(const Json& config, const Assembly& a, const Json& scheme_section) {
+void check_reference_cost(const Json& config, const Assembly& a, const Json& scheme_section, double limit) {
   const Json& ref = config["reference"];
   const double t_end = config["time"]["t_end"];
-  const double limit = max_steps();
   const double period = a.reformulation->fast_period();
   if (scheme_section.contains("substeps_per_period") && period > 0.0) {
     const double substeps = scheme_section["substeps_per_period"].get<double>();
@@ -85,53 +87,48 @@ void check_reference_cost(const Json& config, const Assembly& a, const Json& sch
 
 }  // namespace
 
-namespace {
-double max_steps_limit = default_max_steps;
-}  // namespace
-
-void set_max_steps(double limit) {
-  if (!(limit >= 1.0 && limit <= 1e12))
+RunSettings RunSettings::from_flags(int tau_grid_threads, int fft_threads, double max_steps) {
+  if (!(max_steps >= 1.0 && max_steps <= 1e12))
     throw ConfigError("--max-steps", fmt::format("got {}, expected a number of steps from 1 to 1e12 (beyond "
                                                  "1e12, t_end / h is refused whatever the limit)",
-                                                 limit));
-  max_steps_limit = limit;
+                                                 max_steps));
+  return {Context::with_threads(tau_grid_threads, fft_threads), max_steps};
 }
 
-double max_steps() { return max_steps_limit; }
-
-void check_run_steps(const Json& config) {
+void check_run_steps(const Json& config, double max_steps) {
   const double h = config["time"]["h"], t_end = config["time"]["t_end"];
   const double estimate = t_end / h;  // in double: t_end / h may be 1e300, far beyond a long
-  if (!(estimate <= max_steps()))
+  if (!(estimate <= max_steps))
     throw ConfigError("time.h", fmt::format("got {}: the run would take {:.3g} steps (t_end = {} / h), more than "
                                             "--max-steps = {:.3g}; choose a larger time.h or a smaller time.t_end, "
                                             "or raise the limit with --max-steps N",
-                                            h, estimate, t_end, max_steps()));
+                                            h, estimate, t_end, max_steps));
 }
 
-void check_work_estimate(const Json& config, const Registry& registry) {
-  check_run_steps(config);
-  if (config.contains("reference")) check_reference_cost(config, registry);
+void check_work_estimate(const Json& config, const Registry& registry, const RunSettings& settings) {
+  check_run_steps(config, settings.max_steps);
+  if (config.contains("reference")) check_reference_cost(config, registry, settings);
 }
 
-void check_reference_cost(const Json& config, const Registry& registry) {
+void check_reference_cost(const Json& config, const Registry& registry, const RunSettings& settings) {
   const Json& ref = config["reference"];
   const Json scheme_section =
       reference_scheme_section(ref, registry.scheme(ref["scheme"], "reference.scheme"), 1.0, 1.0);
-  check_reference_cost(config, reference_assembly(config, registry, scheme_section), scheme_section);
+  check_reference_cost(config, reference_assembly(config, registry, scheme_section, settings), scheme_section,
+                       settings.max_steps);
 }
 
 namespace {
 
 // The reference's final state in model variables, with its scheme's tolerance scaled by
 // `tol_factor` and its substeps per fast period by `substep_factor`.
-Vector reference_model_state(const Json& config, const Registry& registry, double tol_factor, double substep_factor,
-                             const ProgressFn& progress, const char* what) {
+Vector reference_model_state(const Json& config, const Registry& registry, const RunSettings& settings,
+                             double tol_factor, double substep_factor, const ProgressFn& progress, const char* what) {
   const Json& ref = config["reference"];
   const SchemeEntry& scheme = registry.scheme(ref["scheme"], "reference.scheme");
   const Json scheme_section = reference_scheme_section(ref, scheme, tol_factor, substep_factor);
-  Assembly a = reference_assembly(config, registry, scheme_section);
-  if (tol_factor == 1.0 && substep_factor == 1.0) check_reference_cost(config, a, scheme_section);
+  Assembly a = reference_assembly(config, registry, scheme_section, settings);
+  if (tol_factor == 1.0 && substep_factor == 1.0) check_reference_cost(config, a, scheme_section, settings.max_steps);
   const double t_end = config["time"]["t_end"];
   Vector y = a.reformulation->prepare(a.u0);
   if (t_end > 0.0) {
@@ -170,18 +167,19 @@ double rounding_floor(const Model& model, const Vector& u) {
 
 }  // namespace
 
-ReferenceSolution compute_reference(const Json& config, const Registry& registry, const ProgressFn& progress) {
+ReferenceSolution compute_reference(const Json& config, const Registry& registry, const RunSettings& settings,
+                                    const ProgressFn& progress) {
   ReferenceSolution out;
   out.settings = config["reference"];
   const auto start = Clock::now();
-  const Vector u = reference_model_state(config, registry, 1.0, 1.0, progress, "reference");  // its cost checked first
+  const Vector u = reference_model_state(config, registry, settings, 1.0, 1.0, progress, "reference");  // its cost checked first
   std::shared_ptr<const Model> model =
-      registry.model(config["model"]["name"]).create(Params(without_name(config["model"])));
+      registry.model(config["model"]["name"]).create(Params(without_name(config["model"]), settings.context));
   out.x = model->to_physical(u);
   out.wall_seconds = seconds_since(start);
   out.accuracy = std::numeric_limits<double>::quiet_NaN();
   if (out.settings.value("estimate_accuracy", true)) {
-    const Vector tighter = model->to_physical(reference_model_state(config, registry, 0.1, 2.0, progress, "reference check"));
+    const Vector tighter = model->to_physical(reference_model_state(config, registry, settings, 0.1, 2.0, progress, "reference check"));
     out.accuracy = std::max(model->error_norm(out.x - tighter) / model->error_norm(tighter),
                             rounding_floor(*model, u));
   }
@@ -226,8 +224,9 @@ std::vector<std::uint64_t> state_shape(const Json& config, Index dim) {
 
 }  // namespace
 
-RunOutcome execute_run(const Json& config, const Registry& registry, const ProgressFn& progress,
-                       const ReferenceSolution* shared_reference, const std::string& stream_dir) {
+RunOutcome execute_run(const Json& config, const Registry& registry, const RunSettings& settings,
+                       const ProgressFn& progress, const ReferenceSolution* shared_reference,
+                       const std::string& stream_dir) {
   RunOutcome outcome;
   Json& result = outcome.result;
   result["tsi_version"] = version_string;
@@ -239,10 +238,11 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   // the data are prepared: the preparation's temporaries are gone by then.
   AssemblyOptions assembly_options;
   assembly_options.bind = false;
+  assembly_options.context = settings.context;
   Assembly assembly = assemble(config, registry, assembly_options);
   // A reference that could not finish is refused now, not after the run.
-  check_run_steps(config);
-  if (config.contains("reference") && !shared_reference) check_reference_cost(config, registry);
+  check_run_steps(config, settings.max_steps);
+  if (config.contains("reference") && !shared_reference) check_reference_cost(config, registry, settings);
   const SchemeEntry& scheme_entry = *assembly.scheme_entry;
   std::shared_ptr<const Model> model = assembly.model;
   const Vector u0 = assembly.u0;
@@ -419,7 +419,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const Progr
   if (outcome.ok && config.contains("reference")) {
     ReferenceSolution ref;
     try {
-      ref = shared_reference ? *shared_reference : compute_reference(config, registry, progress);
+      ref = shared_reference ? *shared_reference : compute_reference(config, registry, settings, progress);
     } catch (const ConfigError&) {
       throw;
     } catch (const std::exception& e) {

@@ -46,28 +46,37 @@ struct ReferenceSolution {
 /// The most steps a run (t_end / time.h) or its reference may take unless --max-steps says
 /// otherwise: generous (hours of work for the cheapest scheme), but a typo's 1e12 is refused.
 inline constexpr double default_max_steps = 1e9;
-/// Sets the limit (tsi run/study --max-steps); a ConfigError naming --max-steps below 1.
-void set_max_steps(double limit);
-double max_steps();
 
-/// Refuses (ConfigError naming time.h) a run whose t_end / h exceeds max_steps(), with the
+/// What the runner's flags give a run besides its config, built once (tsi run and study, the
+/// Python module's run) and passed down: the threads it may use and the most steps it or its
+/// reference may take. Nothing is set process wide.
+struct RunSettings {
+  Context context;                       ///< --threads (its tau grid), --fft-threads (FFTW's own)
+  double max_steps = default_max_steps;  ///< --max-steps
+  /// The settings of these flags: a ConfigError naming the flag for a value out of range
+  /// (threads below 1; a step limit outside 1 .. 1e12).
+  static RunSettings from_flags(int tau_grid_threads, int fft_threads, double max_steps);
+};
+
+/// Refuses (ConfigError naming time.h) a run whose t_end / h exceeds max_steps, with the
 /// estimate and how to lift the limit; computed in double, before anything is narrowed.
-void check_run_steps(const Json& resolved);
+void check_run_steps(const Json& resolved, double max_steps);
 
 /// Refuses (ConfigError naming reference or reference.h) a reference that would take more
-/// than max_steps() steps: an adaptive solver's fast-period cap times t_end, or t_end / reference.h.
-void check_reference_cost(const Json& resolved, const Registry& registry);
+/// than max_steps steps: an adaptive solver's fast-period cap times t_end, or t_end / reference.h.
+void check_reference_cost(const Json& resolved, const Registry& registry, const RunSettings& settings);
 
 /// The work estimate of a run before it starts: check_run_steps, and check_reference_cost
 /// when it has a reference.
-void check_work_estimate(const Json& resolved, const Registry& registry);
+void check_work_estimate(const Json& resolved, const Registry& registry, const RunSettings& settings);
 
 /// Called now and then with the fraction done of what is being computed ("run", or
 /// "reference" and "reference check" for the reference's two solves), for a progress line.
 using ProgressFn = std::function<void(double fraction, const char* what)>;
 
 /// Computes the reference solution a resolved config asks for ("reference" section).
-ReferenceSolution compute_reference(const Json& resolved, const Registry& registry, const ProgressFn& progress = {});
+ReferenceSolution compute_reference(const Json& resolved, const Registry& registry, const RunSettings& settings,
+                                    const ProgressFn& progress = {});
 
 /// What identifies a reference: the model section, t_end and the reference section. Runs
 /// with equal keys share one reference.
@@ -80,8 +89,9 @@ std::string reference_key(const Json& resolved);
 /// caught and reported in the outcome; bad input (ConfigError) propagates.
 /// With `stream_dir`, the rows of invariants.csv are written to
 /// stream_dir/invariants.csv.partial as they are computed (write_run_files renames it).
-RunOutcome execute_run(const Json& resolved, const Registry& registry, const ProgressFn& progress = {},
-                       const ReferenceSolution* reference = nullptr, const std::string& stream_dir = "");
+RunOutcome execute_run(const Json& resolved, const Registry& registry, const RunSettings& settings,
+                       const ProgressFn& progress = {}, const ReferenceSolution* reference = nullptr,
+                       const std::string& stream_dir = "");
 
 /// The physical state as JSON: real numbers, or [re, im] pairs for a complex model.
 Json state_to_json(const Vector& x, bool complex_state);

@@ -77,11 +77,12 @@ int study_exit_code(const Json& rows, const std::vector<std::string>& io_errors)
 }
 
 int study_command(PluginLoader& loader, Registry& registry, const std::string& study_path, std::string out_dir,
-                  int jobs, const std::vector<std::string>& overrides, bool plots, bool resume, bool force) {
+                  int jobs, const std::vector<std::string>& overrides, bool plots, const RunSettings& settings,
+                  bool resume, bool force) {
   Json spec = load_config_file(study_path);
   if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
     load_config_plugins(loader, spec["base"]["plugins"], study_path);
-  const Study study = expand_study(spec, registry, overrides, study_path);
+  const Study study = expand_study(spec, registry, overrides, study_path, settings);
   if (out_dir.empty()) out_dir = "out/" + std::filesystem::path(study_path).stem().string();
   prepare_output_dir(out_dir);
   resume = claim_study_dir(out_dir, study, resume, force);

@@ -16,7 +16,7 @@ namespace tsi::app {
 /// another study in out_dir are replaced instead of refused.
 int study_command(PluginLoader& loader, Registry& registry, const std::string& study_path,
                   std::string out_dir, int jobs, const std::vector<std::string>& overrides, bool plots,
-                  bool resume = false, bool force = false);
+                  const RunSettings& settings, bool resume = false, bool force = false);
 
 /// A study's progress line on stderr (done/total, elapsed, time to go), silent when not `tty`.
 StudyProgressFn terminal_progress(bool tty, std::chrono::steady_clock::time_point start);

@@ -32,11 +32,11 @@ using Clock = std::chrono::steady_clock;
 constexpr const char* shard_file = "shard.json";
 
 Study load_study(PluginLoader& loader, Registry& registry, const std::string& study_path,
-                 const std::vector<std::string>& overrides) {
+                 const std::vector<std::string>& overrides, const RunSettings& settings) {
   Json spec = load_config_file(study_path);
   if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
     load_config_plugins(loader, spec["base"]["plugins"], study_path);
-  return expand_study(spec, registry, overrides, study_path);
+  return expand_study(spec, registry, overrides, study_path, settings);
 }
 
 int default_jobs(int jobs) {
@@ -46,7 +46,7 @@ int default_jobs(int jobs) {
 // --- one shard --------------------------------------------------------------------------------
 
 int shard_command(PluginLoader& loader, Registry& registry, const StudyCli& cli, const ShardSpec& shard) {
-  const Study study = load_study(loader, registry, cli.study_path, cli.overrides);
+  const Study study = load_study(loader, registry, cli.study_path, cli.overrides, cli.settings);
   const std::string out_dir =
       cli.out_dir.empty()
           ? fmt::format("out/{}-shard-{}-of-{}", fs::path(cli.study_path).stem().string(), shard.index, shard.count)
@@ -330,8 +330,8 @@ int study_entry(PluginLoader& loader, Registry& registry, const StudyCli& cli) {
   }
 #endif
   if (!cli.shard.empty()) return shard_command(loader, registry, cli, shard);
-  return study_command(loader, registry, cli.study_path, cli.out_dir, cli.jobs, cli.overrides, cli.plots, cli.resume,
-                       cli.force);
+  return study_command(loader, registry, cli.study_path, cli.out_dir, cli.jobs, cli.overrides, cli.plots,
+                       cli.settings, cli.resume, cli.force);
 }
 
 }  // namespace tsi::app

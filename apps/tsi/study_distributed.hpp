@@ -21,6 +21,7 @@ struct StudyCli {
   std::vector<std::string> merge_dirs;  ///< --merge DIR... (empty: no merge)
   bool resume = false;                  ///< --resume: keep the finished runs of this study in --out
   bool force = false;                   ///< --force: replace another study's results in --out
+  RunSettings settings;                 ///< --threads, --fft-threads, --max-steps
 };
 
 /// Runs `tsi study` as the command line asks: the whole study (study_command), one shard of

@@ -142,7 +142,7 @@ Plan make_plan(PluginLoader& loader, Registry& registry, const StudyCli& cli) {
   Json spec = load_config_file(cli.study_path);
   if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
     load_config_plugins(loader, spec["base"]["plugins"], cli.study_path);
-  p.study = expand_study(spec, registry, cli.overrides, cli.study_path);
+  p.study = expand_study(spec, registry, cli.overrides, cli.study_path, cli.settings);
   p.out_dir = cli.out_dir.empty() ? "out/" + std::filesystem::path(cli.study_path).stem().string() : cli.out_dir;
   std::map<std::string, long> index;
   for (size_t i = 0; i < p.study.runs.size(); ++i) {
@@ -170,7 +170,8 @@ class Worker {
       Json reply = {{"kind", "reference"}, {"index", index}};
       try {
         const ReferenceSolution r =
-            compute_reference(plan_.study.runs[plan_.reference_run[static_cast<size_t>(index)]].config, registry_);
+            compute_reference(plan_.study.runs[plan_.reference_run[static_cast<size_t>(index)]].config, registry_,
+                              plan_.study.settings);
         references_[index] = r;
         reply["ok"] = true;
         reply["reference"] = reference_to_json(r);
@@ -188,7 +189,7 @@ class Worker {
       outcome = not_run(run);
     } else {
       try {
-        outcome = execute_run(run.config, registry_, {}, r >= 0 ? &references_.at(r) : nullptr,
+        outcome = execute_run(run.config, registry_, plan_.study.settings, {}, r >= 0 ? &references_.at(r) : nullptr,
                               plan_.out_dir + "/runs/" + run.id);
       } catch (const IoError& e) {  // its output directory could not be made or written
         outcome = failed_run_outcome(run, e.what());

@@ -114,7 +114,7 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
   parallel_for(n_references + study.runs.size(), jobs, [&](size_t task) {
     if (task < n_references) {
       try {
-        references[task] = compute_reference(*reference_configs[task], registry);
+        references[task] = compute_reference(*reference_configs[task], registry, study.settings);
       } catch (const std::exception& e) {
         reference_errors[task] = e.what();
       } catch (...) {
@@ -149,7 +149,7 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
       reference = &references[r];
     }
     try {
-      outcomes[i] = execute_run(run.config, registry, {}, reference,
+      outcomes[i] = execute_run(run.config, registry, study.settings, {}, reference,
                                 out_dir.empty() ? std::string() : out_dir + "/runs/" + run.id);
     } catch (const IoError& e) {  // its output directory could not be made or written
       outcomes[i] = failed_run_outcome(run, e.what());

@@ -67,12 +67,13 @@ bool is_unknown_parameter(const ConfigError& e) {
 }  // namespace
 
 Study expand_study(const Json& spec, const Registry& registry, const std::vector<std::string>& overrides,
-                   const std::string& study_path) {
+                   const std::string& study_path, const RunSettings& settings) {
   if (!spec.is_object()) throw ConfigError("study", "got " + spec.dump() + ", expected a JSON object");
   for (const auto& [key, value] : spec.items())
     if (key != "kind" && key != "title" && key != "base" && key != "vary" && key != "cases")
       throw ConfigError(key, "unknown study key; valid keys are: base, cases, kind, title, vary");
   Study study;
+  study.settings = settings;
   study.spec = spec;
   study.kind = string_entry(spec, "kind", "convergence", "kind");
   if (std::find(kinds.begin(), kinds.end(), study.kind) == kinds.end())
@@ -207,9 +208,9 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
   std::set<std::string> references;
   for (const auto& run : study.runs) {
     try {
-      check_run_steps(run.config);
+      check_run_steps(run.config, settings.max_steps);
       if (run.config.contains("reference") && references.insert(reference_key(run.config)).second)
-        check_reference_cost(run.config, registry);
+        check_reference_cost(run.config, registry, settings);
     } catch (const ConfigError& e) {
       const std::string what = e.what();
       const std::string message = e.field().empty() ? what : what.substr(e.field().size() + 2);

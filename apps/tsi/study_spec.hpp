@@ -2,6 +2,7 @@
 #include <string>
 #include <vector>
 
+#include "run.hpp"
 #include "tsi/params.hpp"
 #include "tsi/registry.hpp"
 
@@ -29,6 +30,7 @@ struct Study {
   /// Base settings that only some runs take (a parameter of some schemes or models only): path
   /// -> the ids of the runs that do not take it. The others run with it.
   Json not_used = Json::object();
+  RunSettings settings;  ///< what every run may use (threads) and take (--max-steps)
 };
 
 /// The most runs a study may expand to (counted before expanding): far beyond any real study,
@@ -40,6 +42,6 @@ inline constexpr long max_study_runs = 100000;
 /// --set assignments applied to the base. Files the runs name (model.u0 as a .npy file) are
 /// relative to the directory of `study_path` (empty: the working directory).
 Study expand_study(const Json& spec, const Registry& registry, const std::vector<std::string>& overrides,
-                   const std::string& study_path = {});
+                   const std::string& study_path = {}, const RunSettings& settings = {});
 
 }  // namespace tsi::app

@@ -274,17 +274,17 @@ Assembly assemble(const Json& resolved, const Registry& registry, const Assembly
   a.model_entry = &registry.model(resolved.at("model").at("name"));
   a.reformulation_entry = &registry.reformulation(resolved.at("reformulation").at("name"));
   a.scheme_entry = &registry.scheme(resolved.at("scheme").at("name"));
-  a.model = a.model_entry->create(Params(without_name(resolved["model"])));
+  a.model = a.model_entry->create(Params(without_name(resolved["model"]), options.context));
   a.u0 = initial_value(*a.model, resolved["model"]);
   a.traits = scheme_traits(*a.scheme_entry, without_name(resolved["scheme"]));
   // The scheme first (its parameters only): its vector count for the problem's layout sizes the
   // footprint, checked before the reformulation allocates anything of the state's size.
-  a.scheme = a.scheme_entry->create(Params(without_name(resolved["scheme"])));
+  a.scheme = a.scheme_entry->create(Params(without_name(resolved["scheme"]), options.context));
   const bool binds = options.bind && resolved.contains("time") && resolved["time"].contains("h") &&
                      resolved["time"]["h"].is_number();
   a.footprint = two_scale_footprint(*a.model, resolved["reformulation"], *a.scheme, a.scheme_entry->info.name, binds);
   check_footprint(a.footprint, options.memory_bytes);
-  a.reformulation = a.reformulation_entry->create(a.model, Params(without_name(resolved["reformulation"])));
+  a.reformulation = a.reformulation_entry->create(a.model, Params(without_name(resolved["reformulation"]), options.context));
   const StepperTraits& traits = a.traits;
   const std::string pair = fmt::format("model \"{}\" on the \"{}\" reformulation", a.model_entry->info.name,
                                        a.reformulation_entry->info.name);

@@ -16,8 +16,6 @@ namespace tsi {
 namespace {
 // FFTW's planner is not thread-safe; execution of distinct plans is.
 std::mutex planner_mutex;
-std::atomic<int> threads_setting{1};
-std::atomic<long> threads_min_values{65536};
 
 // Rows per contiguous block of a buffered batch, and the smallest batch that is buffered
 // (measured, 256-point transforms: 4 rows best from 64 to 1024 rows; at 16 rows the strided
@@ -30,27 +28,22 @@ fftw_plan as_plan(void* p) { return static_cast<fftw_plan>(p); }
 fftw_complex* raw(Complex* p) { return reinterpret_cast<fftw_complex*>(p); }
 }  // namespace
 
-void set_fft_threads(int threads, long min_values) {
-  if (threads < 1) throw ConfigError("fft threads", "got " + std::to_string(threads) + ", expected at least 1");
-  threads_setting = threads;
-  threads_min_values = min_values;
-}
-
-FftBatch::FftBatch(int n, int howmany, int parts) : n_(n), howmany_(howmany) {
+FftBatch::FftBatch(int n, int howmany, int parts, ThreadLimit fftw_threads) : n_(n), howmany_(howmany) {
   if (n <= 0 || howmany <= 0) throw Error("FftBatch: sizes must be positive");
   if (parts < 1 || parts > howmany) throw Error("FftBatch: parts must be from 1 to the number of rows");
   std::lock_guard<std::mutex> lock(planner_mutex);
   static const bool threads_ready = fftw_init_threads() != 0;
   const long values = static_cast<long>(n) * howmany;
-  const bool fftw_threads = threads_ready && values >= threads_min_values && threads_setting.load() > 1;
-  if (threads_ready) fftw_plan_with_nthreads(fftw_threads ? threads_setting.load() : 1);
+  const int fftw_team = threads_ready ? fftw_threads.for_size(values) : 1;
+  const bool fftw_split = fftw_team > 1;
+  if (threads_ready) fftw_plan_with_nthreads(fftw_team);
   for (int p = 0; p <= parts; ++p) part_rows_.push_back(static_cast<int>(static_cast<long>(howmany) * p / parts));
   const int signs[2] = {FFTW_FORWARD, FFTW_BACKWARD};
   bool planned = true;
   // FFTW's own threads (tsi --fft-threads) split the strided plans; otherwise large batches
   // are buffered.
   // n even: every row of a block then has the block's alignment, as fftw_execute_dft needs.
-  const bool buffered = !fftw_threads && howmany >= buffered_min_rows && n >= buffered_min_points && n % 2 == 0;
+  const bool buffered = !fftw_split && howmany >= buffered_min_rows && n >= buffered_min_points && n % 2 == 0;
   if (!buffered) {  // the strided plans are made on the buffer itself
     buffer_ = reinterpret_cast<Complex*>(fftw_alloc_complex(static_cast<size_t>(n) * howmany));
     if (!buffer_)

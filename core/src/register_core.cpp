@@ -94,7 +94,8 @@ void register_core(Registry& registry) {
                                              : method == "central" ? TwoScale::DataMethod::central
                                                                    : TwoScale::DataMethod::automatic;
     const bool real_layout = !p.has("real_layout") || p.boolean("real_layout");
-    return std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation, data_method, real_layout);
+    return std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation, data_method, real_layout,
+                                      p.context());
   };
   registry.add_reformulation(std::move(two_scale));
 

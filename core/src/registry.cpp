@@ -101,11 +101,6 @@ struct Registry::Impl {
   std::string provider = "core";
 };
 
-Registry& Registry::global() {
-  static Registry registry;
-  return registry;
-}
-
 Registry::Registry() : impl_(std::make_unique<Impl>()) {}
 Registry::~Registry() = default;
 

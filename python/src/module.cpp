@@ -26,7 +26,7 @@
 #include "study_report.hpp"
 #include "study_runner.hpp"
 #include "study_spec.hpp"
-#include "tsi/tau_grid_threads.hpp"
+#include "tsi/context.hpp"
 #include "tsi/error.hpp"
 #include "tsi/matrix_model.hpp"
 #include "tsi/model.hpp"
@@ -39,10 +39,15 @@ using tsi::Json;
 
 namespace {
 
-// The process-wide registry and loader, shared with every plugin loaded from Python. Never
-// destroyed: plugins and Python models registered into it live as long as the process.
+// The Python session's registry and loader, shared with every plugin loaded from Python. Never
+// destroyed: plugins and Python models registered into it live as long as the interpreter.
+tsi::Registry& session_registry() {
+  static auto* instance = new tsi::Registry;
+  return *instance;
+}
+
 tsi::PluginLoader& loader() {
-  static auto* instance = new tsi::PluginLoader(tsi::Registry::global());
+  static auto* instance = new tsi::PluginLoader(session_registry());
   return *instance;
 }
 
@@ -291,7 +296,7 @@ void register_python_model(const std::string& name, py::object cls, const std::s
       return std::make_unique<PythonModel>(eps, instance, name);
     });
   };
-  tsi::Registry& registry = tsi::Registry::global();
+  tsi::Registry& registry = session_registry();
   const std::string provider = "python:" + name;
   registry.remove_provider(provider);
   const std::string previous = registry.provider();
@@ -360,7 +365,7 @@ void register_python_field(const std::string& name, py::object function, long di
   entry.create = [function_ref, name, is_complex](tsi::Index) {
     return std::make_shared<PythonField>(function_ref, name, is_complex);
   };
-  tsi::Registry& registry = tsi::Registry::global();
+  tsi::Registry& registry = session_registry();
   const std::string provider = "python-field:" + name;
   registry.remove_provider(provider);
   const std::string previous = registry.provider();
@@ -409,7 +414,7 @@ py::dict outcome_dict(const tsi::app::RunOutcome& outcome) {
 
 py::dict run(const std::string& config_text, const std::string& out_dir, int threads) {
   if (threads < 0) throw tsi::ConfigError("threads", "got " + std::to_string(threads) + ", expected at least 1 (or None: all cores)");
-  tsi::Registry& registry = tsi::Registry::global();
+  tsi::Registry& registry = session_registry();
   const Json raw = parse(config_text, "config");
   if (raw.is_object() && raw.contains("plugins")) tsi::app::load_config_plugins(loader(), raw["plugins"], "./config");
   const Json config = tsi::app::resolve_run_config(raw, registry);
@@ -418,12 +423,10 @@ py::dict run(const std::string& config_text, const std::string& out_dir, int thr
   // As `tsi run`: the run's tau grid on every core unless told otherwise; studies keep one
   // thread per run (their runs share the cores).
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  tsi::set_tau_grid_threads(threads > 0 ? threads : cores);
-  struct Restore {
-    ~Restore() { tsi::set_tau_grid_threads(1); }
-  } restore;
+  const auto settings =
+      tsi::app::RunSettings::from_flags(threads > 0 ? threads : cores, 1, tsi::app::default_max_steps);
   const auto outcome = interruptible<tsi::app::RunOutcome>(
-      [&] { return tsi::app::execute_run(config, registry); }, was_interrupted);
+      [&] { return tsi::app::execute_run(config, registry, settings); }, was_interrupted);
   if (!out_dir.empty()) tsi::app::write_run_files(out_dir, outcome);
   py::dict d = outcome_dict(outcome);
   d["interrupted"] = was_interrupted;
@@ -432,7 +435,7 @@ py::dict run(const std::string& config_text, const std::string& out_dir, int thr
 
 py::dict study(const std::string& spec_text, int jobs, const std::vector<std::string>& overrides,
                const std::string& out_dir) {
-  tsi::Registry& registry = tsi::Registry::global();
+  tsi::Registry& registry = session_registry();
   const Json spec = parse(spec_text, "study");
   if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
     tsi::app::load_config_plugins(loader(), spec["base"]["plugins"], "./study");
@@ -505,11 +508,11 @@ PYBIND11_MODULE(_tsi, m) {
   m.def(
       "init",
       [] {
-        tsi::Registry& registry = tsi::Registry::global();
+        tsi::Registry& registry = session_registry();
         return tsi::app::load_plugins(loader(), registry, {});
       },
       "Registers the core and loads the shipped plugins and TSI_PLUGIN_PATH; returns the warnings.");
-  m.def("list", [](const std::string& what) { return tsi::app::list_json(tsi::Registry::global(), what).dump(); },
+  m.def("list", [](const std::string& what) { return tsi::app::list_json(session_registry(), what).dump(); },
         py::arg("what") = "");
   m.def("load_plugin", [](const std::string& path) { loader().load(path); }, py::arg("path"));
   m.def("plugin_directory", &tsi::PluginLoader::default_directory);

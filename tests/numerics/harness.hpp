@@ -34,13 +34,13 @@ class Harness {
   std::shared_ptr<const Model> model_with(const std::string& name, double eps, Json params) const {
     const auto& e = registry_.model(name);
     params["eps"] = eps;
-    return e.create(Params(resolve_params(e.info.params, params, "model")));
+    return e.create(Params(resolve_params(e.info.params, params, "model"), context));
   }
 
   std::unique_ptr<Reformulation> reformulation(const std::string& name, std::shared_ptr<const Model> m,
                                                const Json& params = Json::object()) const {
     const auto& e = registry_.reformulation(name);
-    return e.create(std::move(m), Params(resolve_params(e.info.params, params, "reformulation")));
+    return e.create(std::move(m), Params(resolve_params(e.info.params, params, "reformulation"), context));
   }
 
   /// A scheme, its parameters completed for `model` on the two-scale reformulation (SE2's
@@ -56,6 +56,10 @@ class Harness {
 
   const Registry& registry() const { return registry_; }
 
+  /// The context the models and reformulations made here get (threads; ContextSetting below
+  /// sets it for one test case).
+  Context context;
+
  private:
   Harness() : loader_(registry_) {
     register_core(registry_);
@@ -63,6 +67,24 @@ class Harness {
   }
   Registry registry_;
   PluginLoader loader_;
+};
+
+/// Sets the harness's context for a scope and restores the default however it ends.
+struct ContextSetting {
+  explicit ContextSetting(const Context& c) { Harness::instance().context = c; }
+  ~ContextSetting() { Harness::instance().context = Context{}; }
+  /// Threads on the tau grid for grids of at least min_values.
+  static Context tau_grid(int threads, long min_values) {
+    Context c;
+    c.tau_grid = {threads, min_values};
+    return c;
+  }
+  /// FFTW's threads for batches of at least min_values.
+  static Context fft(int threads, long min_values) {
+    Context c;
+    c.fft = {threads, min_values};
+    return c;
+  }
 };
 
 /// Every registered scheme that integrates the two-scale problem, by name.

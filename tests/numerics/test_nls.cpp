@@ -402,23 +402,21 @@ TEST_CASE("nls: a user's u0 is read as samples on the x grid") {
   CHECK(tsi::test::contains(wrong.err, "model.u0"));
 }
 
-TEST_CASE("nls: FFTW on two threads gives the one-thread answer (set_fft_threads, tsi --fft-threads)") {
+TEST_CASE("nls: FFTW on two threads gives the one-thread answer (Context::fft, tsi --fft-threads)") {
   // Threads for every batch here (min_values 1), so that a small grid exercises them.
   auto& h = Harness::instance();
   const auto run = [&](int threads) {
-    tsi::set_fft_threads(threads, 1);
+    const tsi::test::ContextSetting setting(tsi::test::ContextSetting::fft(threads, 1));
     auto model = h.model_with("nls", 0.01, {{"n_x", 32}});
     auto two_scale = h.reformulation("two-scale", model, {{"n_tau", 64}});
     auto se1 = h.scheme("se1");
-    const Vector x = tsi::test::solve(*model, *two_scale, *se1, 0.5, 4);
-    tsi::set_fft_threads(1);
-    return x;
+    return tsi::test::solve(*model, *two_scale, *se1, 0.5, 4);
   };
   const Vector one = run(1), two = run(2);
   const double difference = (one - two).norm() / one.norm();
   CAPTURE(difference);
   CHECK(difference < 1e-13);
-  CHECK_THROWS_AS(tsi::set_fft_threads(0), tsi::ConfigError);
+  CHECK_THROWS_AS(tsi::Context::with_threads(1, 0), tsi::ConfigError);
 
   const tsi::test::TempDir dir("tsi-nls-threads");
   const auto r = tsi::test::run_tsi(

@@ -9,7 +9,7 @@
 #include "harness.hpp"
 #include "tsi/fft.hpp"
 #include "tsi/real_fft.hpp"
-#include "tsi/tau_grid_threads.hpp"
+#include "tsi/context.hpp"
 
 namespace {
 
@@ -135,10 +135,12 @@ TEST_CASE("real layout: on two tau-grid threads the field is the one-thread fiel
   if (!tsi::tau_grid_threads_available()) return;
   auto& h = Harness::instance();
   const auto field = [&](int threads) {
-    tsi::set_tau_grid_threads(threads, 1);
+    std::unique_ptr<tsi::Reformulation> r;
     auto model = h.model("henon-heiles", 0.01);
-    auto r = h.reformulation("two-scale", model, {{"n_tau", 64}});
-    tsi::set_tau_grid_threads(1);
+    {
+      const tsi::test::ContextSetting setting(tsi::test::ContextSetting::tau_grid(threads, 1));
+      r = h.reformulation("two-scale", model, {{"n_tau", 64}});
+    }
     REQUIRE(r->threads() == threads);
     const Vector y = r->prepare(model->initial_value()) * 3.0;
     Vector out;

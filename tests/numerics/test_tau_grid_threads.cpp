@@ -1,4 +1,4 @@
-// One two-scale run on several threads (tsi/tau_grid_threads.hpp): the tau grid's rows are
+// One two-scale run on several threads (tsi::Context::tau_grid): the tau grid's rows are
 // transformed and its columns evaluated by different threads. The split must not change the
 // answer, must stay off where the model shares state or the grid is small, and a model error
 // on one thread must reach the caller.
@@ -9,7 +9,7 @@
 #include "harness.hpp"
 #include "runner/run_command.hpp"
 #include "tsi/error.hpp"
-#include "tsi/tau_grid_threads.hpp"
+#include "tsi/context.hpp"
 
 namespace {
 
@@ -18,10 +18,9 @@ using tsi::Index;
 using tsi::Vector;
 using tsi::test::Harness;
 
-// Restores the default setting however a test case ends.
-struct ThreadSetting {
-  ThreadSetting(int threads, long min_values) { tsi::set_tau_grid_threads(threads, min_values); }
-  ~ThreadSetting() { tsi::set_tau_grid_threads(1); }
+// The harness's reformulations get `threads` on grids of at least min_values, for a scope.
+struct ThreadSetting : tsi::test::ContextSetting {
+  ThreadSetting(int threads, long min_values) : ContextSetting(tau_grid(threads, min_values)) {}
 };
 
 // u' = J[(1/eps) M u + grad H1] with a linear grad H1 (so any answer is easy to predict), whose
@@ -115,7 +114,7 @@ TEST_CASE("tau grid threads: only large grids of models with independent binding
     CHECK(r->threads() == 1);
     CHECK(shared->bindings_ == 1);
   }
-  CHECK_THROWS_AS(tsi::set_tau_grid_threads(0), tsi::ConfigError);
+  CHECK_THROWS_AS(tsi::Context::with_threads(0, 1), tsi::ConfigError);
 }
 
 TEST_CASE("tau grid threads: a model error on another thread reaches the caller") {

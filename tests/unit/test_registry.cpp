@@ -131,7 +131,3 @@ TEST_CASE("registry: remove_provider removes exactly that provider's entries") {
   r.add_model(model("x-model", {"xm"}));  // the names are free again
   CHECK(r.model("xm").info.provider == "core");
 }
-
-TEST_CASE("registry: global() is one instance") {
-  CHECK(&tsi::Registry::global() == &tsi::Registry::global());
-}

@@ -41,6 +41,8 @@ struct TSI_API AssemblyOptions {
   /// The memory a two-scale run may take, in bytes (0: what the machine has available now);
   /// a run whose footprint exceeds it is refused, naming its sizes, before it is built.
   double memory_bytes = 0.0;
+  /// What the run may use of the process (its threads), given to every entry's create().
+  Context context;
 };
 
 /// The footprint of a two-scale run of `model` with these resolved reformulation parameters

@@ -3,21 +3,19 @@
 #include <memory>
 #include <vector>
 
+#include "tsi/context.hpp"
 #include "tsi/export.hpp"
 #include "tsi/types.hpp"
 
 namespace tsi {
 
-/// Threads FFTW may use for each batch of at least `min_values` complex numbers planned from
-/// now on (1, the default, for none: a study already runs one run per core). Small batches
-/// (Henon-Heiles, NLS with n_x = 16) stay on one thread, where splitting costs more than it saves.
-TSI_API void set_fft_threads(int threads, long min_values = 65536);
-
 /// In-place complex FFTs along the tau direction of a batch of states stored column by
 /// column (howmany rows, n columns; entry (i, j) at i + howmany * j). Plans are made once
 /// in the constructor (planning is serialised across threads) and reused by every call.
 /// With `parts` > 1 the rows are also split into that many contiguous ranges, so that threads
-/// can transform disjoint rows of the one buffer at the same time.
+/// can transform disjoint rows of the one buffer at the same time. `fftw_threads`: the threads
+/// FFTW itself may use for the whole batch (Context::fft; 1, the default, for none: small
+/// batches stay on one thread, where splitting costs more than it saves).
 ///
 /// Large batches (at least 32 rows of an even number, at least 32, of points) go through a small contiguous
 /// buffer, a few rows at a time: FFTW_ESTIMATE's plan for the strided batch walks the whole
@@ -27,7 +25,7 @@ TSI_API void set_fft_threads(int threads, long min_values = 65536);
 /// first called: transform() works on the caller's memory through the blocks alone.
 class TSI_API FftBatch {
  public:
-  FftBatch(int n, int howmany, int parts = 1);
+  FftBatch(int n, int howmany, int parts = 1, ThreadLimit fftw_threads = {});
   ~FftBatch();
   FftBatch(const FftBatch&) = delete;
   FftBatch& operator=(const FftBatch&) = delete;

@@ -15,7 +15,9 @@ namespace tsi {
 /// backward(forward(a)) = n a; index k >= n/2 holds the wave number k - n.
 class GridFft {
  public:
-  GridFft(int n, Index columns) : fft_(n, static_cast<int>(columns)), n_(n), columns_(columns) {}
+  /// `fftw_threads`: FFTW's own threads for the batch (the run's Context::fft).
+  GridFft(int n, Index columns, ThreadLimit fftw_threads = {})
+      : fft_(n, static_cast<int>(columns), 1, fftw_threads), n_(n), columns_(columns) {}
 
   /// columns x n: row j is state j (grid samples or Fourier coefficients).
   Eigen::Map<Matrix> data() { return fft_.data(); }
@@ -43,15 +45,18 @@ class GridFft {
 /// synchronised: the model serialises its calls (its buffers are shared work space).
 class GridFftPool {
  public:
-  explicit GridFftPool(int n) : n_(n) {}
+  explicit GridFftPool(int n, ThreadLimit fftw_threads = {}) : n_(n), fftw_threads_(fftw_threads) {}
   GridFft& get(Index columns) {
     auto it = batches_.find(columns);
-    if (it == batches_.end()) it = batches_.emplace(columns, std::make_unique<GridFft>(n_, columns)).first;
+    if (it == batches_.end())
+      it = batches_.emplace(columns, std::make_unique<GridFft>(n_, columns, fftw_threads_)).first;
     return *it->second;
   }
+  ThreadLimit fftw_threads() const { return fftw_threads_; }
 
  private:
   int n_;
+  ThreadLimit fftw_threads_;
   std::map<Index, std::unique_ptr<GridFft>> batches_;
 };
 

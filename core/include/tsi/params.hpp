@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "tsi/context.hpp"
 #include "tsi/export.hpp"
 
 namespace tsi {
@@ -48,20 +49,24 @@ TSI_API ParamSpec integer_or_string_param(std::string name, Json default_value, 
 /// returns the object with every default filled in.
 TSI_API Json resolve_params(const ParamSchema& schema, const Json& given, const std::string& path);
 
-/// Typed read access to a resolved parameter object.
+/// Typed read access to a resolved parameter object, and the run's context (what it may use
+/// of the process: threads), which tsi::assemble gives every entry it creates.
 class TSI_API Params {
  public:
-  explicit Params(Json values = Json::object()) : values_(std::move(values)) {}
+  explicit Params(Json values = Json::object(), Context context = {})
+      : values_(std::move(values)), context_(context) {}
   double number(const std::string& name) const;
   long integer(const std::string& name) const;
   bool boolean(const std::string& name) const;
   std::string string(const std::string& name) const;
   bool has(const std::string& name) const;  ///< present and not null
   const Json& raw() const { return values_; }
+  const Context& context() const { return context_; }
 
  private:
   const Json& at(const std::string& name) const;
   Json values_;
+  Context context_;
 };
 
 }  // namespace tsi

@@ -30,7 +30,7 @@ class TSI_API Reformulation : public Problem {
   /// configured order when the asymptotic recursion stopped at its smallest correction.
   virtual int data_order_reached() const { return 0; }
   /// Threads the reformulation's evaluations use (two-scale on a large tau grid: see
-  /// tsi/tau_grid_threads.hpp; 1 otherwise).
+  /// tsi::Context::tau_grid; 1 otherwise).
   virtual int threads() const { return 1; }
 
   const Model& model() const { return *model_; }

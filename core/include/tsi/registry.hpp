@@ -107,9 +107,7 @@ TSI_API StepperTraits default_traits(const SchemeEntry& scheme);
 /// runtime selection). Look-ups accept names and aliases; a miss lists the valid names.
 class TSI_API Registry {
  public:
-  /// The process-wide registry that the runner and all plugins share.
-  static Registry& global();
-
+  /// A run's registry is its caller's (the runner's, a Python session's): nothing is process wide.
   Registry();
   ~Registry();
   Registry(const Registry&) = delete;

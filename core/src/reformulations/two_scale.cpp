@@ -15,16 +15,15 @@
 #include "tsi/algebra.hpp"
 #include "tsi/error.hpp"
 #include "tsi/phase.hpp"
-#include "tsi/tau_grid_threads.hpp"
 
 namespace tsi {
 namespace {
 
 // The tau grid's threads: only for a model whose bindings are independent, never more than
 // the grid has rows (the transforms' parts) or columns.
-int grid_threads(const Model& model, int n_tau) {
+int grid_threads(const Model& model, int n_tau, const Context& context) {
   if (!model.independent_tau_grid_bindings()) return 1;
-  const Index threads = std::min<Index>({tau_grid_threads_for(model.dim() * n_tau), model.dim(), n_tau});
+  const Index threads = std::min<Index>({context.tau_grid_threads_for(model.dim() * n_tau), model.dim(), n_tau});
   return static_cast<int>(std::max<Index>(threads, 1));
 }
 
@@ -69,7 +68,7 @@ constexpr int central_fallback_order = 4;
 }  // namespace
 
 TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order,
-                   Repreparation repreparation, DataMethod data_method, bool real_layout)
+                   Repreparation repreparation, DataMethod data_method, bool real_layout, const Context& context)
     : Reformulation(std::move(model)),
       dim_(model_->dim()),
       n_tau_(n_tau),
@@ -81,7 +80,7 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
       taus_(n_tau),
       remainder_(model_remainder(*model_)),
       wave_numbers_(n_tau),
-      threads_(grid_threads(*model_, n_tau)),
+      threads_(grid_threads(*model_, n_tau, context)),
       repreparation_(repreparation) {
   if (n_tau <= 0 || n_tau % 2 != 0)
     throw ConfigError("reformulation.n_tau",
@@ -112,7 +111,7 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
     real_fft_ = std::make_unique<RealFftBatch>(n_tau, rows, threads_);
     grid_values_.setZero(dim_, n_tau);
   } else {
-    fft_ = std::make_unique<FftBatch>(n_tau, rows, threads_);
+    fft_ = std::make_unique<FftBatch>(n_tau, rows, threads_, context.fft);
   }
   grid_field_ = model_->bind_tau_grid(taus_);
   for (int p = 0; p <= threads_; ++p) column_begin_.push_back(static_cast<Index>(n_tau) * p / threads_);

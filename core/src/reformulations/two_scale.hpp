@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "tsi/context.hpp"
 #include "tsi/fft.hpp"
 #include "tsi/real_fft.hpp"
 #include "tsi/reformulation.hpp"
@@ -57,10 +58,11 @@ class TwoScale final : public Reformulation {
   };
 
   /// `real_layout`: keep a real model's state in the real layout (false: all N_tau modes, as
-  /// for a complex model; the same numbers to rounding).
+  /// for a complex model; the same numbers to rounding). `context`: the threads the run may
+  /// use on its tau grid and in FFTW.
   TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order,
            Repreparation repreparation = {}, DataMethod data_method = DataMethod::automatic,
-           bool real_layout = true);
+           bool real_layout = true, const Context& context = {});
 
   Index size() const override { return dim_ * columns_; }
   /// True when the state holds modes 0 .. N_tau/2 of a real U (the real layout).
@@ -177,7 +179,7 @@ class TwoScale final : public Reformulation {
   RealVector wave_numbers_;  // k of each Fourier index; the Nyquist index holds n/2
   Diagonal multipliers_;  // per tau mode without a remainder (diagonal_run), else per unknown
   Vector remainder_grid_;  // remainder_ on every tau point (empty without a remainder)
-  int threads_;  // threads on the tau grid (tsi::tau_grid_threads_for); 1: the serial path
+  int threads_;  // threads on the tau grid (Context::tau_grid_threads_for); 1: the serial path
   std::vector<Index> column_begin_;  // threads_ + 1 boundaries of the threads' tau columns
   std::vector<std::unique_ptr<TauGridField>> column_fields_;  // f_tau on each thread's columns
   // Complex layout:

@@ -72,8 +72,9 @@ struct Phases {
 
 class KleinGordon final : public tsi::Model {
  public:
-  KleinGordon(double eps, int n_x, double lambda)
-      : Model(eps), n_x_(n_x), lambda_(lambda), inverse_a_(n_x), remainder_(n_x), batches_(n_x) {
+  // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
+  KleinGordon(double eps, int n_x, double lambda, tsi::ThreadLimit fftw_threads = {})
+      : Model(eps), n_x_(n_x), lambda_(lambda), inverse_a_(n_x), remainder_(n_x), batches_(n_x, fftw_threads) {
     for (int j = 0; j < n_x; ++j) {
       const double k = 2 * j <= n_x ? j : j - n_x;  // the Nyquist index as k = n_x / 2
       const double root = std::sqrt(1.0 + eps * k * k);
@@ -109,7 +110,7 @@ class KleinGordon final : public tsi::Model {
   class GridField final : public tsi::TauGridField {
    public:
     GridField(const KleinGordon& model, const tsi::RealVector& taus)
-        : model_(model), phases_(taus), batch_(model.n_x_, taus.size()) {}
+        : model_(model), phases_(taus), batch_(model.n_x_, taus.size(), model.batches_.fftw_threads()) {}
     void evaluate(MatrixRef c, MatrixRef out) override { model_.fused_field<true>(phases_, batch_, c, out); }
 
    private:
@@ -280,7 +281,8 @@ void register_klein_gordon(tsi::Registry& registry) {
   // to h = 1/128 (order 0.90 over 1/16 .. 1/128, 1.74 over 1/64 .. 1/512).
   entry.verification = {{1.0, 1.0 / 256, 1e-4, 1e-6}, {16, 32, 64, 128}};
   entry.create = [](const tsi::Params& p) {
-    return std::make_unique<KleinGordon>(p.number("eps"), static_cast<int>(p.integer("n_x")), p.number("lambda"));
+    return std::make_unique<KleinGordon>(p.number("eps"), static_cast<int>(p.integer("n_x")), p.number("lambda"),
+                                         p.context().fft);
   };
   registry.add_model(std::move(entry));
 }

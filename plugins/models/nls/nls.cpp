@@ -39,7 +39,9 @@ using tsi::Vector;
 
 class Nls final : public tsi::Model {
  public:
-  Nls(double eps, int n_x) : Model(eps), n_x_(n_x), wave_numbers_(n_x), batches_(n_x) {
+  // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
+  Nls(double eps, int n_x, tsi::ThreadLimit fftw_threads = {})
+      : Model(eps), n_x_(n_x), wave_numbers_(n_x), batches_(n_x, fftw_threads) {
     for (int k = 0; k < n_x; ++k) wave_numbers_(k) = 2 * k < n_x ? k : k - n_x;
     batch(1);  // the single-state plans (filtered, direct, invariants)
   }
@@ -88,7 +90,7 @@ class Nls final : public tsi::Model {
   class GridField final : public tsi::TauGridField {
    public:
     GridField(const Nls& model, const tsi::RealVector& taus)
-        : model_(model), taus_(taus), batch_(model.n_x_, model.slice(taus.size())) {
+        : model_(model), taus_(taus), batch_(model.n_x_, model.slice(taus.size()), model.batches_.fftw_threads()) {
       // A small grid keeps its phases in a table (read, not recomputed: 15% of a step at
       // n_x = 16, n_tau = 256); a large one computes them as it goes (no table of half the
       // state's size).
@@ -171,7 +173,7 @@ class Nls final : public tsi::Model {
     // A large batch (the prepared data's, a run's tau grid) gets transforms of its own for this
     // call, freed after it: the derivative is not needed while the run steps.
     std::unique_ptr<tsi::GridFft> own;
-    if (slice(c.cols()) < c.cols()) own = std::make_unique<tsi::GridFft>(n_x_, slice(c.cols()));
+    if (slice(c.cols()) < c.cols()) own = std::make_unique<tsi::GridFft>(n_x_, slice(c.cols()), batches_.fftw_threads());
     tsi::GridFft& b = own ? *own : batch(c.cols());
     tsi::Matrix& grid = b.scratch();
     const Complex scale(0.0, -1.0 / (tsi::two_pi * n_x_));
@@ -363,7 +365,7 @@ void register_nls(tsi::Registry& registry) {
   entry.nonlinearity_degree = 3;
   entry.verification = {{1.0, 1.0 / 16, 1.0 / 256}, {4, 8, 16, 32}};
   entry.create = [](const tsi::Params& p) {
-    return std::make_unique<Nls>(p.number("eps"), static_cast<int>(p.integer("n_x")));
+    return std::make_unique<Nls>(p.number("eps"), static_cast<int>(p.integer("n_x")), p.context().fft);
   };
   registry.add_model(std::move(entry));
 }
