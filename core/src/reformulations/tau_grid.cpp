@@ -1,0 +1,299 @@
+#include "tau_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <string>
+
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
+
+#include "tsi/error.hpp"
+#include "tsi/phase.hpp"
+
+namespace tsi {
+namespace {
+
+// n_tau, checked before anything of its size is allocated.
+int checked_n_tau(int n_tau) {
+  if (n_tau <= 0 || n_tau % 2 != 0)
+    throw ConfigError("reformulation.n_tau", "got " + std::to_string(n_tau) + ", expected a positive even integer");
+  return n_tau;
+}
+
+// The tau grid's threads: only for a model whose bindings are independent, never more than
+// the grid has rows (the transforms' parts) or columns.
+int grid_threads(const Model& model, int n_tau, const Context& context) {
+  if (!model.independent_tau_grid_bindings()) return 1;
+  const Index threads = std::min<Index>({context.tau_grid_threads_for(model.dim() * n_tau), model.dim(), n_tau});
+  return static_cast<int>(std::max<Index>(threads, 1));
+}
+
+#if defined(_OPENMP)
+int thread_index() { return omp_get_thread_num(); }
+int team_size() { return omp_get_num_threads(); }
+void barrier() {
+#pragma omp barrier
+}
+#else
+int thread_index() { return 0; }
+int team_size() { return 1; }
+void barrier() {}
+#endif
+
+}  // namespace
+
+TauGrid::TauGrid(std::shared_ptr<const Model> model, int n_tau, bool real_layout, const Context& context,
+                 long& evaluations)
+    : model_(std::move(model)),
+      dim_(model_->dim()),
+      n_tau_(checked_n_tau(n_tau)),
+      real_layout_(real_layout && real_layout_for(*model_)),
+      columns_(real_layout_ ? n_tau / 2 + 1 : n_tau),
+      evaluations_(&evaluations),
+      taus_(n_tau),
+      wave_numbers_(n_tau),
+      threads_(grid_threads(*model_, n_tau, context)) {
+  for (int j = 0; j < n_tau; ++j) {
+    taus_(j) = two_pi * j / n_tau;
+    wave_numbers_(j) = j <= n_tau / 2 ? j : j - n_tau;
+  }
+  const int rows = static_cast<int>(dim_);
+  if (real_layout_) {
+    real_fft_ = std::make_unique<RealFftBatch>(n_tau, rows, threads_);
+    grid_values_.setZero(dim_, n_tau);
+  } else {
+    fft_ = std::make_unique<FftBatch>(n_tau, rows, threads_, context.fft);
+  }
+  grid_field_ = model_->bind_tau_grid(taus_);
+  for (int p = 0; p <= threads_; ++p) column_begin_.push_back(static_cast<Index>(n_tau) * p / threads_);
+  for (int p = 0; threads_ > 1 && p < threads_; ++p)
+    column_fields_.push_back(model_->bind_tau_grid(taus_.segment(column_begin_[p], column_begin_[p + 1] - column_begin_[p])));
+  if (real_layout_) {
+    real_kernels_ = grid_field_->evaluates_real();
+    for (const auto& f : column_fields_) real_kernels_ = real_kernels_ && f->evaluates_real();
+    bool in_place = real_kernels_ && grid_field_->in_place();
+    for (const auto& f : column_fields_) in_place = in_place && f->in_place();
+    if (!in_place) field_values_.setZero(dim_, n_tau);
+    if (!real_kernels_) {
+      complex_grid_.setZero(dim_, n_tau);
+      complex_field_.setZero(dim_, n_tau);
+    }
+  }
+}
+
+bool TauGrid::real_layout_for(const Model& model) {
+  // A remainder turns coordinates by complex phases: its U is complex (a real model has none).
+  return !model.is_complex() && !model.has_linear_remainder();
+}
+
+void TauGrid::nonlinear(const Vector& y, const Vector* mean_shift, Vector& out) {
+  ++*evaluations_;
+  if (real_layout_) return nonlinear_real(y, mean_shift, out);
+  if (threads_ > 1) return nonlinear_threaded(y, mean_shift, out);
+  // The grid in out's storage: the tau transforms go through their small blocks, and a model
+  // that evaluates in place needs no grid of the state's size besides out.
+  out.resize(size());
+  fft_->transform(y.data(), out.data(), 1, 1.0, mean_shift ? mean_shift->data() : nullptr);
+  Eigen::Map<Matrix> grid(out.data(), dim_, n_tau_);
+  Complex* field = out.data();
+  if (grid_field_->in_place()) {
+    grid_field_->evaluate(grid, grid);
+  } else {
+    field_.resize(dim_, n_tau_);
+    grid_field_->evaluate(grid, field_);
+    field = field_.data();
+  }
+  fft_->transform(field, out.data(), 0, 1.0 / n_tau_);  // the 1/n of the transform
+}
+
+void TauGrid::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out) {
+  // As the serial path: the grid in out's storage, each thread's rows transformed through its
+  // own block, the field in place where the model allows it.
+  out.resize(size());
+  const bool in_place = std::all_of(column_fields_.begin(), column_fields_.end(),
+                                    [](const std::unique_ptr<TauGridField>& f) { return f->in_place(); });
+  if (!in_place) field_.resize(dim_, n_tau_);
+  Eigen::Map<Matrix> grid(out.data(), dim_, n_tau_);
+  Complex* field = in_place ? out.data() : field_.data();
+  const Complex* shift = mean_shift ? mean_shift->data() : nullptr;
+  on_grid_threads([&](int p) { fft_->transform(y.data(), out.data(), 1, 1.0, shift, p); },
+                  [&](int p, Index c0, Index cn) {
+                    if (in_place)
+                      column_fields_[p]->evaluate(grid.middleCols(c0, cn), grid.middleCols(c0, cn));
+                    else
+                      column_fields_[p]->evaluate(grid.middleCols(c0, cn), field_.middleCols(c0, cn));
+                  },
+                  [&](int p) { fft_->transform(field, out.data(), 0, 1.0 / n_tau_, nullptr, p); });
+}
+
+template <class In, class Field, class Out>
+void TauGrid::on_grid_threads(In&& transform_in, Field&& evaluate, Out&& transform_out) {
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads_));
+  // Transforms go by rows, the field by columns; every phase reads what the one before wrote
+  // on other threads, hence the barriers. A team smaller than asked for (an OpenMP limit)
+  // takes several parts per thread.
+#if defined(_OPENMP)
+#pragma omp parallel num_threads(threads_)
+#endif
+  {
+    for (int p = thread_index(); p < threads_; p += team_size()) transform_in(p);
+    barrier();
+    for (int p = thread_index(); p < threads_; p += team_size()) {
+      try {
+        evaluate(p, column_begin_[p], column_begin_[p + 1] - column_begin_[p]);
+      } catch (...) {
+        errors[p] = std::current_exception();
+      }
+    }
+    barrier();
+    for (int p = thread_index(); p < threads_; p += team_size()) transform_out(p);
+  }
+  for (const auto& error : errors)
+    if (error) std::rethrow_exception(error);
+}
+
+void TauGrid::nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& out) {
+  out.resize(size());
+  const bool in_place = field_values_.size() == 0;
+  const double* field = in_place ? grid_values_.data() : field_values_.data();
+  const auto transform_in = [&](int part) {
+    // The mean shift is a constant in tau: added to the grid values, as to the mean mode.
+    real_fft_->backward(y.data(), grid_values_.data(), part);
+    if (!mean_shift) return;
+    const Index r0 = part < 0 ? 0 : real_fft_->part_begin(part);
+    const Index rn = part < 0 ? dim_ : real_fft_->part_begin(part + 1) - r0;
+    grid_values_.middleRows(r0, rn).colwise() += mean_shift->segment(r0, rn).real();
+  };
+  const double scale = 1.0 / n_tau_;  // the 1/n of the transform
+  if (threads_ <= 1) {
+    transform_in(-1);
+    evaluate_real_grid(*grid_field_, 0, n_tau_);
+    real_fft_->forward_unnormalised(field, out.data());
+    out *= scale;
+    return;
+  }
+  on_grid_threads(transform_in, [&](int p, Index c0, Index cn) { evaluate_real_grid(*column_fields_[p], c0, cn); },
+                  [&](int p) {
+                    real_fft_->forward_unnormalised(field, out.data(), p);
+                    const Index r0 = real_fft_->part_begin(p), rn = real_fft_->part_begin(p + 1) - r0;
+                    Eigen::Map<Matrix>(out.data(), dim_, columns_).middleRows(r0, rn) *= scale;
+                  });
+}
+
+void TauGrid::evaluate_real_grid(TauGridField& field, Index c0, Index cn) {
+  auto values = grid_values_.middleCols(c0, cn);
+  if (real_kernels_) {
+    if (field_values_.size() == 0) return field.evaluate_real(values, values);
+    return field.evaluate_real(values, field_values_.middleCols(c0, cn));
+  }
+  complex_grid_.middleCols(c0, cn) = values.cast<Complex>();
+  field.evaluate(complex_grid_.middleCols(c0, cn), complex_field_.middleCols(c0, cn));
+  field_values_.middleCols(c0, cn) = complex_field_.middleCols(c0, cn).real();
+}
+
+
+Matrix TauGrid::to_grid(const Matrix& c) {
+  if (real_layout_) {
+    RealMatrix values(dim_, n_tau_);
+    real_fft_->backward(c.data(), values.data());  // modes 0 .. N/2: the first columns of c
+    return values.cast<Complex>();
+  }
+  Matrix grid(dim_, n_tau_);
+  fft_->transform(c.data(), grid.data(), 1);
+  return grid;
+}
+
+Matrix TauGrid::to_coefficients(Matrix grid) {
+  if (real_layout_) {
+    const RealMatrix values = grid.real();
+    grid.resize(0, 0);
+    Matrix c(dim_, columns_);
+    real_fft_->forward_unnormalised(values.data(), c.data());
+    c *= 1.0 / n_tau_;
+    return all_modes(c);
+  }
+  fft_->transform(grid.data(), grid.data(), 0, 1.0 / n_tau_);
+  return grid;
+}
+
+Matrix TauGrid::all_modes(ConstMatrixRef stored) const {
+  if (!real_layout_) return stored;
+  Matrix c(dim_, n_tau_);
+  c.leftCols(columns_) = stored;
+  for (int j = 1; 2 * j < n_tau_; ++j) c.col(n_tau_ - j) = stored.col(j).conjugate();
+  return c;
+}
+
+double TauGrid::coefficient_norm(const Vector& y, bool without_mean) const {
+  const Eigen::Map<const Matrix> c(y.data(), dim_, columns_);
+  double sum = 0.0;
+  for (int j = without_mean ? 1 : 0; j < columns_; ++j)
+    sum += (real_layout_ && j > 0 && 2 * j < n_tau_ ? 2.0 : 1.0) * c.col(j).squaredNorm();
+  return std::sqrt(sum);
+}
+
+Matrix TauGrid::f_coefficients(Matrix w) {
+  ++*evaluations_;
+  if (grid_field_->in_place()) {
+    grid_field_->evaluate(w, w);
+    return to_coefficients(std::move(w));
+  }
+  Matrix f(dim_, n_tau_);
+  grid_field_->evaluate(w, f);
+  w.resize(0, 0);
+  return to_coefficients(std::move(f));
+}
+
+Matrix TauGrid::df_coefficients(Matrix w, Matrix z) {
+  ++*evaluations_;
+  model_->linear_flow(taus_, w);
+  model_->linear_flow(taus_, z);
+  Matrix df(dim_, n_tau_);
+  model_->nonlinear_field_derivative(w, z, df);
+  w.resize(0, 0);
+  z.resize(0, 0);
+  model_->linear_flow(RealVector(-taus_), df);
+  return to_coefficients(std::move(df));
+}
+
+Matrix TauGrid::apply_A(Matrix c) const {
+  for (int j = 0; j < n_tau_; ++j) {
+    if (antiderivative(j) == 0.0)
+      c.col(j).setZero();
+    else
+      c.col(j) /= Complex(0.0, wave_numbers_(j));
+  }
+  return c;
+}
+
+Complex TauGrid::antiderivative(int j) const {
+  return j == 0 || 2 * j == n_tau_ ? Complex(0.0) : 1.0 / Complex(0.0, wave_numbers_(j));
+}
+
+
+Vector TauGrid::evaluate(ConstMatrixRef c, double tau) const {
+  Vector value = Vector::Zero(dim_);
+  if (c.cols() != n_tau_) {  // the real layout: modes k and -k together, 2 Re(c_k e^{i k tau})
+    for (int j = 0; j < c.cols(); ++j) {
+      if (j == 0)
+        value += c.col(0).real().cast<Complex>();
+      else if (2 * j == n_tau_)
+        value += c.col(j).real().cast<Complex>() * std::cos(0.5 * n_tau_ * tau);
+      else
+        value += (2.0 * (c.col(j) * std::polar(1.0, j * tau)).real()).cast<Complex>();
+    }
+    return value;
+  }
+  for (int j = 0; j < n_tau_; ++j) {
+    if (2 * j == n_tau_)  // half at +n/2, half at -n/2: a real U stays real
+      value += c.col(j) * std::cos(0.5 * n_tau_ * tau);
+    else
+      value += c.col(j) * std::polar(1.0, wave_numbers_(j) * tau);
+  }
+  return value;
+}
+
+
+}  // namespace tsi
