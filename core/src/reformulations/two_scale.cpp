@@ -16,7 +16,7 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
       remainder_(model_remainder(*model_)),
       grid_(model_, n_tau, real_layout, context, evaluations_),
       data_(grid_, eps_, remainder_, initial_data_order, data_method),
-      repreparation_(repreparation) {
+      repreparer_(grid_, data_, eps_, repreparation) {
   const Index dim = grid_.dim();
   const int columns = grid_.columns();
   if (remainder_.size()) remainder_grid_ = remainder_.replicate(columns, 1);
@@ -64,34 +64,11 @@ void TwoScale::rhs(double t, const Vector& y, Vector& out) {
 }
 
 Vector TwoScale::prepare(const Vector& u0) {
-  repreparation_times_.clear();
-  last_prepared_ = 0;
+  repreparer_.reset();
   return data_.at(u0, 0.0);
 }
 
-bool TwoScale::between_steps(long n, double t, Vector& y) {
-  if (repreparation_.mode == Repreparation::Mode::Never) return false;
-  if (repreparation_.mode == Repreparation::Mode::Every && n % repreparation_.every != 0) return false;
-  if (repreparation_.mode == Repreparation::Mode::Auto && (n - last_prepared_) % repreparation_.min_gap != 0)
-    return false;
-  const double s = fast_phase(t, eps_);
-  const Vector v = grid_.evaluate(Eigen::Map<const Matrix>(y.data(), grid_.dim(), grid_.columns()), s);
-  Vector prepared = data_.at(v, s);
-  if (repreparation_.mode == Repreparation::Mode::Auto) {
-    // U is due when it has drifted off the prepared data through its own diagonal value by more
-    // than a fraction of that data's tau variation (column 0 of the coefficients is the mean).
-    const double variation = grid_.coefficient_norm(prepared, true);
-    // A defect below defect_floor |U| is the scheme's own error, not the characteristics coming
-    // apart (NLS at eps = 0.01: re-preparing on it made err_H 9x worse than never).
-    const double threshold =
-        std::max(repreparation_.defect * variation, repreparation_.defect_floor * grid_.coefficient_norm(prepared));
-    if (!(grid_.coefficient_norm(y - prepared) > threshold)) return false;
-  }
-  y.swap(prepared);
-  repreparation_times_.push_back(t);
-  last_prepared_ = n;
-  return true;
-}
+bool TwoScale::between_steps(long n, double t, Vector& y) { return repreparer_.between_steps(n, t, y); }
 
 Vector TwoScale::read_back(const Vector& y, double t) {
   const double tau = fast_phase(t, eps_);

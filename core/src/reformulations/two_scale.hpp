@@ -4,22 +4,12 @@
 #include <vector>
 
 #include "prepared_data.hpp"
+#include "repreparation.hpp"
 #include "tau_grid.hpp"
 #include "tsi/context.hpp"
 #include "tsi/reformulation.hpp"
 
 namespace tsi {
-
-/// When a two-scale run re-prepares its data (SPEC.md section 6, "Re-preparation").
-struct Repreparation {
-  enum class Mode { Never, Every, Auto } mode = Mode::Never;
-  long every = 0;         ///< Every: each this many steps
-  /// Auto: re-prepare when U's distance from the prepared data at its own diagonal value,
-  /// |U - P(v_n, s_n)|, exceeds this fraction of P's own tau variation |P - mean P|.
-  double defect = 0.1;
-  double defect_floor = 1e-4;  ///< Auto: defects below this fraction of |U| never trigger
-  long min_gap = 10;  ///< Auto: tested (one evaluation of r1) every this many steps
-};
 
 /// The two-scale reformulation (eq. 2scale eq): U(t, tau) on N_tau Fourier modes,
 ///     dU/dt = L U + f_tau(U),   L = -(1/eps) d/dtau + J R,
@@ -29,9 +19,9 @@ struct Repreparation {
 /// A real model's U(tau) is real: its coefficients are Hermitian (c_{-k} = conj c_k), and the
 /// state keeps modes k = 0 .. N_tau/2 only (d x (N_tau/2 + 1), the real layout: half the
 /// memory), transformed by real-to-complex FFTs on a real tau grid.
-/// Three parts: the tau grid (TauGrid: its modes, transforms and f_tau on it), the prepared
-/// data (PreparedData), and this, the problem the schemes integrate, with its re-preparation
-/// between steps and the tau monitors.
+/// Its parts: the tau grid (TauGrid: its modes, transforms and f_tau on it), the prepared data
+/// (PreparedData), their re-preparation between steps (Repreparer), and this, the problem the
+/// schemes integrate, with read-back and the tau monitors.
 class TwoScale final : public Reformulation {
  public:
   /// The largest order of prepared data.
@@ -79,7 +69,7 @@ class TwoScale final : public Reformulation {
   /// Re-prepares U when the rule says so: v_n = U(t_n, s_n), s_n = t_n/eps mod 2 pi, and U
   /// rebuilt as prepared data centred at s_n (U(t_n, s_n) = v_n exactly, u(t_n) unchanged).
   bool between_steps(long n, double t, Vector& y) override;
-  std::vector<double> repreparation_times() const override { return repreparation_times_; }
+  std::vector<double> repreparation_times() const override { return repreparer_.times(); }
   int data_order_reached() const override { return data_.order_reached(); }
   int threads() const override { return grid_.threads(); }
 
@@ -90,9 +80,7 @@ class TwoScale final : public Reformulation {
   PreparedData data_;
   Diagonal multipliers_;  // per tau mode without a remainder (diagonal_run), else per unknown
   Vector remainder_grid_;  // remainder_ on every tau point (empty without a remainder)
-  Repreparation repreparation_;
-  std::vector<double> repreparation_times_;
-  long last_prepared_ = 0;  // the step of the last preparation
+  Repreparer repreparer_;
 };
 
 }  // namespace tsi
