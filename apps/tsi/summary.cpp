@@ -2,7 +2,27 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 namespace tsi::app {
+
+namespace {
+
+// States up to this many values are printed whole at the end of a run's summary.
+constexpr Index max_printed_values = 8;
+
+// The first `count` values of x, each in the fewest digits that read back to the same double (complex:
+// re+imj, as Python and NumPy print them).
+std::string printed_state(const Vector& x, bool complex_state, Index count) {
+  std::string out = "[";
+  for (Index i = 0; i < std::min(count, x.size()); ++i) {
+    if (i > 0) out += ", ";
+    out += complex_state ? fmt::format("{}{:+}j", x(i).real(), x(i).imag()) : fmt::format("{}", x(i).real());
+  }
+  return out + "]";
+}
+
+}  // namespace
 
 std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
   const Json& r = outcome.result;
@@ -17,11 +37,6 @@ std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
   if (r.contains("invariants")) {
     if (r.contains("t_reached") && !outcome.ok)
       s += fmt::format("  reached t = {:g} after {} steps\n", r["t_reached"].get<double>(), r["steps"].get<long>());
-    if (r.contains("error"))
-      s += fmt::format("  relative error at t_end   {:.3e}   (reference {} on {}, tol {:g})\n",
-                       r["error"]["relative"].get<double>(), r["error"]["reference"]["scheme"].get<std::string>(),
-                       r["error"]["reference"]["reformulation"].get<std::string>(),
-                       r["error"]["reference"]["tol"].get<double>());
     for (const char* name : {"H", "I", "m"})  // absent for a model without Hamiltonian structure
       if (r["invariants"].contains(name))
         s += fmt::format("  max rel. change of {}     {:.3e}   ({:.10g} -> {:.10g})\n", name,
@@ -41,6 +56,22 @@ std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
     s += fmt::format("  wall time                 {:.3f} s\n", r["wall_seconds"].get<double>());
   }
   for (const auto& w : r["warnings"]) s += fmt::format("  warning: {}\n", w.get<std::string>());
+  // The answer last, where a user looks for it: u at the end (round-trip digits) and its error.
+  if (outcome.u_final.size() > 0) {
+    const bool whole = outcome.u_final.size() <= max_printed_values;
+    const std::string at = outcome.ok || !r.contains("t_reached")
+                               ? std::string("t_end")
+                               : fmt::format("t = {:g}", r["t_reached"].get<double>());
+    s += whole ? fmt::format("  u({}) = {}\n", at, printed_state(outcome.u_final, outcome.complex_state, max_printed_values))
+               : fmt::format("  u({}) = {} ... ({} values: {}/{})\n", at,
+                             printed_state(outcome.u_final, outcome.complex_state, 4), outcome.u_final.size(), out_dir,
+                             u_final_file);
+  }
+  if (r.contains("error"))
+    s += fmt::format("  relative error at t_end   {:.3e}   (reference {} on {}, tol {:g})\n",
+                     r["error"]["relative"].get<double>(), r["error"]["reference"]["scheme"].get<std::string>(),
+                     r["error"]["reference"]["reformulation"].get<std::string>(),
+                     r["error"]["reference"]["tol"].get<double>());
   s += fmt::format("  written: {0}/result.json, {0}/invariants.csv", out_dir);
   if (outcome.u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, u_final_file);
   if (outcome.reference_u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, reference_u_final_file);

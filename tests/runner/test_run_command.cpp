@@ -1,9 +1,11 @@
 // End-to-end runs of `tsi run`: the files a good run writes, their content, aliases,
 // defaults, and the exit codes of completed and failed runs.
 #include <doctest/doctest.h>
+#include <fmt/format.h>
 
 #include <cmath>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -153,6 +155,42 @@ TEST_CASE("run: output.every thins the rows of invariants.csv but keeps the last
   CHECK(std::stod(csv_fields(lines[2])[0]) == 0.375);
   CHECK(std::stod(csv_fields(lines[3])[0]) == 0.75);
   CHECK(std::stod(csv_fields(lines[4])[0]) == 1.0);
+}
+
+TEST_CASE("run: the summary ends with u(t_end) in round-trip digits and the error") {
+  TempDir dir;
+  const std::string out = dir / "out";
+  const CommandResult r = run_tsi({"run", example_config(), "--out", out, "--set", "time.h=0.25"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  const Json result = read_json(fs::path(out) / "result.json");
+  // The last lines: u(t_end), the error, the files written.
+  std::vector<std::string> lines;
+  std::istringstream text(r.out);
+  for (std::string line; std::getline(text, line);) lines.push_back(line);
+  REQUIRE(lines.size() >= 3);
+  const std::string& u_line = lines[lines.size() - 3];
+  CHECK(contains(lines[lines.size() - 2], "relative error at t_end"));
+  CHECK(contains(lines.back(), "written:"));
+  REQUIRE(contains(u_line, "u(t_end) = ["));
+  // Henon-Heiles' 4 values, each reading back to result.json's double exactly.
+  std::string values = u_line.substr(u_line.find('[') + 1);
+  values = values.substr(0, values.find(']'));
+  std::vector<double> printed;
+  std::istringstream fields(values);
+  for (std::string v; std::getline(fields, v, ',');) printed.push_back(std::stod(v));
+  const Json& u_final = result.at("u_final");
+  REQUIRE(printed.size() == u_final.size());
+  for (size_t i = 0; i < printed.size(); ++i) CHECK(printed[i] == u_final[i].get<double>());
+
+  // A complex state of 16 values: its first 4 as re+imj, and where the rest are.
+  const std::string nls_out = dir / "nls";
+  const CommandResult nls = run_tsi({"run", example_config("nls-se1.json"), "--out", nls_out});
+  INFO(nls.describe());
+  REQUIRE(nls.exit_code == 0);
+  CHECK(contains(nls.out, "... (16 values: " + nls_out + "/u_final.npy)"));
+  const Json nls_u = read_json(fs::path(nls_out) / "result.json").at("u_final");
+  CHECK(contains(nls.out, fmt::format("u(t_end) = [{}{:+}j, ", nls_u[0][0].get<double>(), nls_u[0][1].get<double>())));
 }
 
 TEST_CASE("run: result.json reports the state's memory and the bound scheme's vectors of that size") {
