@@ -145,17 +145,18 @@ def work_precision_figure(rows, title):
     rows = [r for r in rows if number(r["error"]) and number(r["wall_seconds"])]
     fig, axes = plt.subplots(1, 2, figsize=(14, 5.2))
     eps_values = sorted({number(r["eps"]) for r in rows}, reverse=True)
-    colors = {e: f"C{i}" for i, e in enumerate(eps_values)}
     styles = ["o-", "s--", "^:", "v-.", "D-", "P--"]
+    # Several eps: a colour per eps and a line style per scheme; one eps: a colour per scheme.
+    by_eps = len(eps_values) > 1
     for k, name in enumerate(dict.fromkeys(series_name(r) for r in rows)):
-        for eps in eps_values:
+        for i, eps in enumerate(eps_values):
             mine = [r for r in rows if series_name(r) == name and number(r["eps"]) == eps]
             if not mine:
                 continue
             for ax, x in zip(axes, ("wall_seconds", "rhs_evals")):
                 pts = sorted((number(r[x]), number(r["error"])) for r in mine)
-                ax.loglog(*zip(*pts), styles[k % len(styles)], color=colors[eps],
-                          label=f"{name}, eps = {fraction(eps)}")
+                ax.loglog(*zip(*pts), styles[k % len(styles)] if by_eps else "o-",
+                          color=f"C{(i if by_eps else k) % 10}", label=f"{name}, eps = {fraction(eps)}")
     axes[0].set(xlabel="wall time [s]", ylabel="relative error at t_end", title="error against time")
     axes[1].set(xlabel="nonlinearity evaluations (two-scale: one covers all tau points)",
                 ylabel="relative error at t_end", title="error against evaluations")

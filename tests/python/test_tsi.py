@@ -584,6 +584,21 @@ class PlotTests(unittest.TestCase):
                 "vary": {"scheme.name": ["se1"], "time.h": [0.5, 0.25, 0.125]}}
         self.check_same_as_the_script(spec, tsi.plot.work_precision)
 
+    def test_work_precision_colours_schemes_apart_at_one_eps(self):
+        spec = {"kind": "work-precision", "base": {"model": {"name": "hh", "eps": 1e-2}, "reference": {}},
+                "vary": {"scheme.name": ["se1", "me", "fd"], "time.h": [0.5, 0.25]}}
+        fig = tsi.plot.work_precision(tsi.study(spec, jobs=1))
+        lines = fig.axes[0].get_lines()
+        self.assertEqual(len(lines), 3)
+        self.assertEqual(len({line.get_color() for line in lines}), 3)
+        # Two eps: one colour per eps, the schemes told apart by their line styles.
+        spec["vary"]["model.eps"] = [1e-2, 1e-3]
+        fig = tsi.plot.work_precision(tsi.study(spec, jobs=1))
+        lines = fig.axes[0].get_lines()
+        self.assertEqual(len(lines), 6)
+        self.assertEqual(len({line.get_color() for line in lines}), 2)
+        self.assertEqual(len({line.get_linestyle() for line in lines}), 3)
+
     def test_the_wrong_kind_is_refused(self):
         s = tsi.study({"kind": "conservation", "base": HH, "vary": {"time.h": [0.5]}}, jobs=1)
         with self.assertRaises(ValueError):
