@@ -76,6 +76,31 @@ int check_command(PluginLoader& loader, const Registry& registry, CheckOptions o
     params["eps"] = 1.0;
     resolve_params(models.front()->info.params, params, "model");
   }
+  // The checks integrate the two-scale problem: its parameters are checked against it, and
+  // each scheme key must be a parameter of some scheme checked (each scheme takes those it has).
+  if (!options.reformulation_params.is_object()) options.reformulation_params = Json::object();
+  if (!options.scheme_params.is_object()) options.scheme_params = Json::object();
+  if (options.reformulation_params.contains("name"))
+    throw ConfigError("check --set reformulation.name", "is chosen by the check itself (the two-scale problem)");
+  if (options.scheme_params.contains("name"))
+    throw ConfigError("check --set scheme.name", "is chosen by --scheme (repeatable)");
+  if (!options.reformulation_params.empty())
+    resolve_params(registry.reformulation("two-scale").info.params, options.reformulation_params, "reformulation");
+  for (const auto& [key, value] : options.scheme_params.items()) {
+    std::vector<std::string> names;
+    bool taken = false;
+    for (const auto* s : schemes) {
+      names.push_back(s->info.name);
+      for (const auto& p : s->info.params)
+        if (p.name == key) {  // its value checked by each scheme that takes it
+          taken = true;
+          resolve_params(s->info.params, Json{{key, value}}, "scheme");
+        }
+    }
+    if (!taken)
+      throw ConfigError("check --set scheme." + key, fmt::format("is a parameter of none of the schemes checked ({})",
+                                                                 fmt::join(names, ", ")));
+  }
 
   int failed_models = 0;
   for (const auto* entry : models)

@@ -156,7 +156,10 @@ int main(int argc, char** argv) {
   check->add_option("--steps", check_options.steps,
                     "numbers of steps over T = 1 of the order fits (repeatable, increasing; default: the model's regime)");
   std::vector<std::string> check_overrides;
-  check->add_option("--set", check_overrides, "a model parameter: model.KEY=VALUE (repeatable), e.g. model.n_x=64");
+  check->add_option("--set", check_overrides,
+                    "a parameter of the model, the two-scale reformulation or the schemes checked: model.KEY=VALUE, "
+                    "reformulation.KEY=VALUE or scheme.KEY=VALUE (repeatable), e.g. model.n_x=64, reformulation.n_tau=128, "
+                    "scheme.order=3");
   // The runner's own options (--plugin) may also follow a subcommand: tsi run CONFIG --plugin FILE.
   for (auto* sub : app.get_subcommands([](CLI::App*) { return true; })) sub->fallthrough();
   // end tsi check
@@ -187,13 +190,20 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (check->parsed()) {
-      tsi::Json model_overrides = {{"model", tsi::Json::object()}};
+      tsi::Json check_sections = {{"model", tsi::Json::object()},
+                                  {"reformulation", tsi::Json::object()},
+                                  {"scheme", tsi::Json::object()}};
       for (const auto& assignment : check_overrides) {
-        if (assignment.rfind("model.", 0) != 0)
-          throw tsi::ConfigError("check --set", "got \"" + assignment + "\", expected model.KEY=VALUE (model parameters only)");
-        tsi::app::apply_override(model_overrides, assignment);
+        if (assignment.rfind("model.", 0) != 0 && assignment.rfind("reformulation.", 0) != 0 &&
+            assignment.rfind("scheme.", 0) != 0)
+          throw tsi::ConfigError("check --set", "got \"" + assignment +
+                                                    "\", expected model.KEY=VALUE, reformulation.KEY=VALUE or "
+                                                    "scheme.KEY=VALUE");
+        tsi::app::apply_override(check_sections, assignment);
       }
-      check_options.model_params = model_overrides["model"];
+      check_options.model_params = check_sections["model"];
+      check_options.reformulation_params = check_sections["reformulation"];
+      check_options.scheme_params = check_sections["scheme"];
       return tsi::app::check_command(loader, registry, check_options, plugin_files);
     }
     const int rc = study->parsed()

@@ -93,6 +93,20 @@ class ModelChecks {
     m["eps"] = eps;
     return m;
   }
+  /// The scheme's traits with the user's --set scheme parameters (eab's order, ...).
+  StepperTraits traits_of(const SchemeEntry& scheme) const {
+    Json params = Json::object();
+    for (const auto& p : scheme.info.params)
+      if (options_.scheme_params.contains(p.name)) params[p.name] = options_.scheme_params[p.name];
+    return scheme_traits(scheme, resolve_params(scheme.info.params, params, "scheme"));
+  }
+  /// The reformulation section of the checks' configs: the user's --set reformulation
+  /// parameters on the two-scale one.
+  Json reformulation_section(const std::string& name) const {
+    Json r = name == "two-scale" ? options_.reformulation_params : Json::object();
+    r["name"] = name;
+    return r;
+  }
   std::shared_ptr<const Model> model(double eps) const {
     Json params = model_section(eps);
     params.erase("name");
@@ -121,9 +135,10 @@ class ModelChecks {
     for (const auto& p : scheme.info.params) {
       if (p.name == "tol") scheme_section["tol"] = tol;
       if (p.name == "max_iter") scheme_section["max_iter"] = max_iter;
+      if (options_.scheme_params.contains(p.name)) scheme_section[p.name] = options_.scheme_params[p.name];
     }
     return assemble_config({{"model", model_section(eps)},
-                            {"reformulation", {{"name", reformulation}}},
+                            {"reformulation", reformulation_section(reformulation)},
                             {"scheme", scheme_section}},
                            registry_);
   }
@@ -292,8 +307,10 @@ std::vector<double> ModelChecks::errors(const SchemeEntry& scheme, double eps, c
   for (const long n : steps) {
     Assembly a = assembly(scheme, "two-scale", eps, 1e-14, 1000);
     if (n_tau_factor != 1) {  // the same run on a finer tau grid (diagnose)
-      Json config = {{"model", model_section(eps)}, {"reformulation", {{"name", "two-scale"}}},
+      Json config = {{"model", model_section(eps)}, {"reformulation", reformulation_section("two-scale")},
                      {"scheme", {{"name", scheme.info.name}}}};
+      for (const auto& p : scheme.info.params)
+        if (options_.scheme_params.contains(p.name)) config["scheme"][p.name] = options_.scheme_params[p.name];
       const Json resolved = resolve_selection(config, registry_);
       config["reformulation"]["n_tau"] = n_tau_factor * resolved["reformulation"]["n_tau"].get<long>();
       for (const auto& p : scheme.info.params)
@@ -371,12 +388,12 @@ std::string ModelChecks::diagnose(const SchemeEntry& scheme, double eps, const V
 
 void ModelChecks::orders(const SchemeEntry& scheme, double eps, const Vector& x_ref) {
   // Orders above 2 settle later and reach the reference's accuracy sooner: within 0.5.
-  const int order = default_traits(scheme).order;
+  const int order = traits_of(scheme).order;
   const double margin = order > 2 ? high_order_margin : order_margin;
   const auto within = [&](const OrderFit& f) { return f.measurable && std::abs(f.order - order) <= margin; };
   const std::vector<long>& steps = options_.steps;
   const std::vector<double> errs = errors(scheme, eps, x_ref, steps, order > 2 ? high_order_tau_factor : 1);
-  const double floor = reference_floor(eps, floor_for(default_traits(scheme)));
+  const double floor = reference_floor(eps, floor_for(traits_of(scheme)));
   const OrderFit fit = fit_order(step_sizes(steps), errs, floor);
   std::string row;
   for (const double e : errs) row += fmt::format(" {:>9.2e}", e);
@@ -421,7 +438,7 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<double>&
                            const std::vector<Vector>& references) {
   // Uniform order p: max over eps of the error <= C h^p. At a given eps such a scheme's error
   // may dip below that bound (step-size resonances), so the order is fitted on the maximum.
-  const StepperTraits traits = default_traits(scheme);
+  const StepperTraits traits = traits_of(scheme);
   const std::vector<long>& steps = options_.steps;
   std::vector<double> worst(steps.size(), 0.0);
   try {
@@ -501,7 +518,7 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
     fmt::print(out_, " {:>9}", fmt::format("{}1/{}", steps == options_.steps.front() ? "h = " : "", steps));
   fmt::print(out_, " {:>6}  {}\n", "order", "expected");
   for (const auto* scheme : schemes) {
-    if (default_traits(*scheme).classical_order > default_traits(*scheme).order) {
+    if (traits_of(*scheme).classical_order > traits_of(*scheme).order) {
       envelope(*scheme, epsilons, references);
       continue;
     }
@@ -516,7 +533,7 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
   }
   bool any_symmetric = false;
   for (const auto* scheme : schemes) {
-    if (!default_traits(*scheme).symmetric) continue;
+    if (!traits_of(*scheme).symmetric) continue;
     if (!any_symmetric)
       fmt::print(out_, "\n  {:<60} {:>9} {:>9}\n",
                  fmt::format("symmetry: a step h = {:g}, then -h (symmetric schemes)", symmetry_step),

@@ -104,13 +104,31 @@ TEST_CASE("check: --set and --steps are checked before anything runs") {
   for (const std::vector<std::string>& args :
        {std::vector<std::string>{"--set", "model.nosuch=3"}, {"--set", "remainder=exact"},
         {"--set", "model.remainder=sideways"}, {"--steps", "4", "--steps", "2", "--steps", "8"},
-        {"--steps", "4", "--steps", "8"}}) {
+        {"--steps", "4", "--steps", "8"}, {"--set", "scheme.nosuch=3"}, {"--set", "scheme.name=se1"},
+        {"--set", "reformulation.n_tau=7"}, {"--set", "reformulation.name=filtered"}, {"--set", "time.h=0.1"}}) {
     std::vector<std::string> command = {"check", "fixture-stiff", "--plugin", plugin};
     command.insert(command.end(), args.begin(), args.end());
     const t::CommandResult r = t::run_tsi(command);
     INFO(r.describe());
     CHECK(r.exit_code == 2);
-    CHECK((t::contains(r.err, "--set") || t::contains(r.err, "--steps") || t::contains(r.err, "model.")));
+    CHECK((t::contains(r.err, "--set") || t::contains(r.err, "--steps") || t::contains(r.err, "model.") ||
+           t::contains(r.err, "reformulation.n_tau")));
     CHECK(r.out.find("checks passed") == std::string::npos);
   }
+}
+
+TEST_CASE("check: --set reaches the schemes and the two-scale problem of every run") {
+  // eab of order 2 is expected to show order 2 (its traits follow the parameter) and does.
+  const t::CommandResult second =
+      t::run_tsi({"check", "henon-heiles", "--scheme", "eab", "--set", "scheme.order=2", "--eps", "1e-2"});
+  INFO(second.describe());
+  CHECK(second.exit_code == 0);
+  CHECK(t::contains(second.out, "2 +- 0.2"));
+  // Four tau points cannot resolve Henon-Heiles' tau dependence: the order is lost, and the
+  // check measures why.
+  const t::CommandResult coarse =
+      t::run_tsi({"check", "henon-heiles", "--scheme", "se1", "--set", "reformulation.n_tau=4", "--eps", "1e-2"});
+  INFO(coarse.describe());
+  CHECK(coarse.exit_code == 1);
+  CHECK(t::contains(coarse.out, "the tau grid does not resolve the tau dependence"));
 }

@@ -14,6 +14,10 @@ struct TSI_API ModelCheckOptions {
   std::vector<double> epsilons;        ///< eps of the order checks (empty: the model's declared regime)
   std::vector<long> steps;             ///< numbers of steps over T = 1 (empty: the model's declared regime)
   Json model_params = Json::object();  ///< model parameters besides eps
+  /// Parameters of the two-scale reformulation of every run (n_tau, initial_data_order, ...).
+  Json reformulation_params = Json::object();
+  /// Scheme parameters, given to each checked scheme that takes them (tol, order, ...).
+  Json scheme_params = Json::object();
 };
 
 /// What the checks of one model found.
