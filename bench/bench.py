@@ -2,7 +2,8 @@
 """tsi's speed in one run: the cost of a step against its FFTs, and the eps-independent
 advantage over classical solvers, measured side by side on this machine.
 
-    python3 bench/bench.py [--build build] [--out out/bench] [--quick]
+    python3 bench/bench.py [--build build] [--out out/bench] [--quick] [--models M ...] [--eps E ...]
+                           [--benchmark-filter REGEX]
 
 1. Google Benchmark (build/bin/tsi_bench): per model, the nonlinearity over the whole tau
    grid against the FFTs it must do (the bound), and per scheme ns per step, sweeps per
@@ -49,9 +50,11 @@ def cpu_name():
     return platform.processor()
 
 
-def google_benchmark(build, min_time):
-    out = subprocess.run([os.path.join(build, "bin", "tsi_bench"), "--benchmark_format=json",
-                          f"--benchmark_min_time={min_time}"], check=True, capture_output=True, text=True)
+def google_benchmark(build, min_time, benchmark_filter=None):
+    command = [os.path.join(build, "bin", "tsi_bench"), "--benchmark_format=json", f"--benchmark_min_time={min_time}"]
+    if benchmark_filter:
+        command.append(f"--benchmark_filter={benchmark_filter}")
+    out = subprocess.run(command, check=True, capture_output=True, text=True)
     return {b["name"]: b for b in json.loads(out.stdout)["benchmarks"]}
 
 
@@ -65,6 +68,8 @@ def step_table(bench):
             continue
         # step/<model>/<scheme>[/<variant>] (step/cpd/se2/2-nodes)
         _, model, scheme = name.split("/", 2)
+        if f"fft_bound/{model}" not in bench:  # filtered out (--benchmark-filter)
+            continue
         fft = bench[f"fft_bound/{model}"]["real_time"]
         sweeps, evaluations = b.get("sweeps", 0.0), b.get("evaluations", 0.0)
         units = sweeps if sweeps else evaluations  # sweeps of an implicit scheme, else evaluations
@@ -77,7 +82,7 @@ def step_table(bench):
                      f"{bound:>11.0f}{per_unit / bound:>8.2f}")
     lines.append("  nonlinearity over the whole tau grid against its FFT bound:")
     for name, b in bench.items():
-        if name.startswith("nonlinearity/"):
+        if name.startswith("nonlinearity/") and f"fft_bound/{name.split('/')[1]}" in bench:
             model = name.split("/")[1]
             fft = bench[f"fft_bound/{model}"]["real_time"]
             lines.append(f"    {model:<20}{b['real_time']:>10.0f} ns  bound {fft:>8.0f} ns  ratio {b['real_time'] / fft:.2f}")
@@ -97,7 +102,7 @@ def step_table(bench):
                                  f"  step / (evaluations x bound) {ratio:.2f}")
     lines.append("  the same with FFTW on two threads (tsi --fft-threads 2; used from 65536 values per batch):")
     for name, b in bench.items():
-        if name.startswith("nonlinearity_threads/"):
+        if name.startswith("nonlinearity_threads/") and f"nonlinearity/{name.split('/')[1]}" in bench:
             model = name.split("/")[1]
             one = bench[f"nonlinearity/{model}"]["real_time"]
             lines.append(f"    {model:<20}{b['real_time']:>10.0f} ns  one thread {one:>8.0f} ns  speed-up {one / b['real_time']:.2f}")
@@ -147,7 +152,7 @@ def references_agree(tsi, out, model, eps):
     return table[0].get("error") if table else None
 
 
-def eps_table(build, out, models, quick):
+def eps_table(build, out, models, quick, epsilons=EPSILONS):
     tsi = os.path.join(build, "bin", "tsi")
     listing = json.loads(subprocess.run([tsi, "list", "--json"], check=True, capture_output=True, text=True).stdout)
     known = {m["name"] for m in listing["models"]}
@@ -161,7 +166,7 @@ def eps_table(build, out, models, quick):
                          f"problem, h = 1/{1 / TWO_SCALE_REFERENCE['h']:.0f}; at eps = {eps:g} it differs from rk78 on "
                          f"the filtered problem by {agreement:.2e}" if agreement is not None else
                          f"  {model}: the two references could not be compared")
-        for eps in EPSILONS:
+        for eps in epsilons:
             study = study_for(model, eps, model == "nls" and "strang" in schemes, quick)
             path = os.path.join(out, f"study-{model}-{eps:g}.json")
             json.dump(study, open(path, "w"), indent=1)
@@ -210,12 +215,14 @@ def main():
     ap.add_argument("--out", default="out/bench")
     ap.add_argument("--quick", action="store_true", help="shorter benchmarks and fewer step sizes")
     ap.add_argument("--models", nargs="*", default=list(MODELS))
+    ap.add_argument("--eps", nargs="*", type=float, default=list(EPSILONS), help="eps of the time-to-accuracy studies")
+    ap.add_argument("--benchmark-filter", default=None, help="a regex of the Google benchmarks to run (default: all)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     header = [f"tsi bench on {cpu_name()}, {os.cpu_count()} cores, {platform.platform()}"]
-    bench = google_benchmark(args.build, 0.05 if args.quick else 0.3)
+    bench = google_benchmark(args.build, 0.05 if args.quick else 0.3, args.benchmark_filter)
     step_rows, step_lines = step_table(bench)
-    eps_rows, eps_lines = eps_table(args.build, args.out, args.models, args.quick)
+    eps_rows, eps_lines = eps_table(args.build, args.out, args.models, args.quick, args.eps)
     text = "\n".join(header + [""] + step_lines + [""] + eps_lines) + "\n"
     print(text, end="")
     open(os.path.join(args.out, "bench.txt"), "w").write(text)
