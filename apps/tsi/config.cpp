@@ -61,7 +61,18 @@ const ParamSchema& output_schema() {
           .check([](const Json& v) { return v.get<long>() >= 1; }, "a positive integer"),
       number_param("checkpoint_seconds", 30.0,
                    "rewrite result.json (status running, the time reached) at most this often while a run goes")
-          .range(0.0, 1e9, true, false)};
+          .range(0.0, 1e9, true, false),
+      array_param("times",
+                  "times in [0, t_end] at which to write u (result.json's dense_output, and u_times.npy): between the "
+                  "steps from the state interpolated in t with the scheme's order and read back at tau = t/eps")
+          .check(
+              [](const Json& v) {
+                if (v.size() > max_output_times) return false;
+                for (const Json& t : v)
+                  if (!t.is_number() || !std::isfinite(t.get<double>()) || t.get<double>() < 0.0) return false;
+                return true;
+              },
+              "an array of at most 100000 finite times >= 0")};
   return schema;
 }
 

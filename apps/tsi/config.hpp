@@ -1,4 +1,5 @@
 #pragma once
+#include <cstddef>
 #include <istream>
 #include <string>
 
@@ -6,6 +7,9 @@
 #include "tsi/registry.hpp"
 
 namespace tsi::app {
+
+/// The most times output.times may list.
+inline constexpr std::size_t max_output_times = 100000;
 
 /// Parses JSON strictly: a duplicated key, nesting deeper than 64 levels or a number beyond a
 /// double is a ConfigError naming where (`origin`, then the key path).

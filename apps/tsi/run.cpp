@@ -11,6 +11,7 @@
 #include <sys/resource.h>
 
 #include "config.hpp"
+#include "dense_output.hpp"
 #include "interrupt.hpp"
 #include "run_recorder.hpp"
 #include "tsi/assembly.hpp"
@@ -222,6 +223,25 @@ std::vector<std::uint64_t> state_shape(const Json& config, Index dim) {
   }
 }
 
+// result.json's dense_output: the times, the interpolation's degree, and u at each time (null
+// where the run did not reach it) inline up to max_inline_state values in all, else where
+// u_times.npy holds them (NaN where not reached).
+Json dense_output_entry(const DenseOutput& dense, const RunOutcome& outcome) {
+  Json entry = {{"times", dense.times()}, {"degree", dense.degree()}};
+  std::uint64_t per_time = 1;
+  for (const std::uint64_t d : outcome.state_shape) per_time *= d;
+  if (per_time * dense.times().size() > static_cast<std::uint64_t>(max_inline_state)) {
+    std::vector<std::uint64_t> shape = {dense.times().size()};
+    shape.insert(shape.end(), outcome.state_shape.begin(), outcome.state_shape.end());
+    entry["u"] = {{"file", u_times_file}, {"dtype", outcome.complex_state ? "complex128" : "float64"}, {"shape", shape}};
+    return entry;
+  }
+  entry["u"] = Json::array();
+  for (const Vector& u : dense.values())
+    entry["u"].push_back(u.size() ? state_to_json(u, outcome.complex_state) : Json());
+  return entry;
+}
+
 }  // namespace
 
 RunOutcome execute_run(const Json& config, const Registry& registry, const RunSettings& settings,
@@ -289,6 +309,23 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
     outcome.csv_file = stream_dir + "/invariants.csv.partial";
   }
   RunRecorder recorder(*model, *reformulation, u0, config, outcome.csv_file);
+  // u between the steps (output.times), from the scheme's states interpolated in t.
+  std::unique_ptr<DenseOutput> dense;
+  if (config.contains("output") && config["output"].contains("times") && config["output"]["times"].is_array() &&
+      !config["output"]["times"].empty()) {
+    std::vector<double> times;
+    for (const Json& t : config["output"]["times"]) {
+      if (!(t.get<double>() <= t_end))
+        throw ConfigError(fmt::format("output.times[{}]", times.size()),
+                          fmt::format("got {}, expected a time in [0, t_end = {}]", t.get<double>(), t_end));
+      times.push_back(t.get<double>());
+    }
+    if (rconf.contains("reprepare") && rconf["reprepare"] != "never")
+      throw ConfigError("output.times", "cannot be combined with reformulation.reprepare: a re-prepared U is not "
+                                        "smooth in t across its re-preparations, so it is not interpolated there");
+    dense = std::make_unique<DenseOutput>(std::move(times), std::min(assembly.traits.order, 8), h, n_steps, *model,
+                                          *reformulation);
+  }
   std::string status = "completed";
   auto last_progress = Clock::now(), last_checkpoint = Clock::now();
   const double checkpoint_seconds = config.contains("output") ? config["output"].value("checkpoint_seconds", 30.0) : 30.0;
@@ -321,6 +358,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
     stepper = &assembly.bind(config["time"]["h"].get<double>());
     integrate(*stepper, y, n_steps, [&](long n, double t, const Vector& state) {
       const bool go_on = recorder.observe(n, t, state);
+      if (go_on && dense) dense->observe(n, state);  // a finite state only
       if (go_on && interrupted()) {  // kept up to this step, and written as "interrupted"
         status = "interrupted";
         outcome.message = fmt::format("interrupted by signal {} at t = {:.6g} (step {} of {})", interrupt_signal(),
@@ -369,6 +407,11 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   result["status"] = status;
   if (!outcome.ok) result["message"] = outcome.message;
   const Vector x = model->to_physical(recorder.u_last());
+  if (dense) {
+    dense->finish();
+    outcome.output_times = dense->times();
+    outcome.u_times = dense->values();
+  }
   result["steps"] = recorder.steps();
   result["t_end"] = t_end;
   result["t_reached"] = recorder.t_reached();
@@ -376,6 +419,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   outcome.state_shape = state_shape(config, x.size());
   outcome.u_final = x;
   result["u_final"] = state_entry(x, outcome.complex_state, outcome.state_shape, u_final_file);
+  if (dense) result["dense_output"] = dense_output_entry(*dense, outcome);
   result["invariants"] = recorder.invariants_json();
   {
     const char* names[3] = {"H", "I", "m"};

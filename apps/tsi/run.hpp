@@ -21,6 +21,10 @@ struct RunOutcome {
   /// error.reference.u_final), written to u_final.npy and reference_u_final.npy; empty when
   /// the run never started (or its outcome was read back from its files).
   Vector u_final, reference_u_final;
+  /// u at output.times (physical variables, one state per time; empty where the run did not
+  /// reach it), written to u_times.npy (NaN there).
+  std::vector<double> output_times;
+  std::vector<Vector> u_times;
   bool complex_state = false;             ///< complex128 files (a complex model), else float64
   std::vector<std::uint64_t> state_shape;  ///< the files' shape: model.u0's file's, else (dim,)
 };
@@ -32,6 +36,7 @@ inline constexpr Index max_inline_state = 4096;
 /// The file names of the states beside result.json.
 inline constexpr const char* u_final_file = "u_final.npy";
 inline constexpr const char* reference_u_final_file = "reference_u_final.npy";
+inline constexpr const char* u_times_file = "u_times.npy";
 
 /// The reference solution at t_end (physical variables) and how good it is.
 struct ReferenceSolution {

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "tsi/error.hpp"
 #include "tsi/npy.hpp"
@@ -59,6 +60,23 @@ void write_run_files(const std::string& dir, const RunOutcome& outcome) {
                                  result["error"]["reference"].contains("u_final");
     write_state_file(dir + "/" + u_final_file, outcome.u_final, outcome, result.contains("u_final"));
     write_state_file(dir + "/" + reference_u_final_file, outcome.reference_u_final, outcome, reference_entry);
+    if (!outcome.u_times.empty() && outcome.u_final.size() > 0) {  // u at output.times, one row per time
+      const Index per_time = outcome.u_final.size();
+      Vector all(per_time * static_cast<Index>(outcome.u_times.size()));
+      for (size_t k = 0; k < outcome.u_times.size(); ++k)
+        all.segment(static_cast<Index>(k) * per_time, per_time) =
+            outcome.u_times[k].size() == per_time
+                ? outcome.u_times[k]
+                : Vector::Constant(per_time, Complex(std::numeric_limits<double>::quiet_NaN(), 0.0));
+      std::vector<std::uint64_t> shape = {outcome.u_times.size()};
+      std::uint64_t product = 1;
+      for (const std::uint64_t d : outcome.state_shape) product *= d;
+      if (!outcome.state_shape.empty() && product == static_cast<std::uint64_t>(per_time))
+        shape.insert(shape.end(), outcome.state_shape.begin(), outcome.state_shape.end());
+      else
+        shape.push_back(static_cast<std::uint64_t>(per_time));
+      write_npy(dir + "/" + u_times_file, all, outcome.complex_state, shape);
+    }
   } catch (const IoError& e) {
     state_error = e.what();
   }

@@ -409,6 +409,10 @@ py::dict outcome_dict(const tsi::app::RunOutcome& outcome) {
   d["message"] = outcome.message;
   d["u_final"] = state_array(outcome.u_final, outcome);
   d["reference_u_final"] = state_array(outcome.reference_u_final, outcome);
+  py::list u_times;  // u at output.times, None where the run did not reach the time
+  for (const tsi::Vector& u : outcome.u_times) u_times.append(state_array(u, outcome));
+  d["output_times"] = outcome.output_times;
+  d["u_times"] = u_times;
   return d;
 }
 

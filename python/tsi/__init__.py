@@ -67,6 +67,21 @@ def _state(values):
     return a[..., 0] + 1j * a[..., 1] if a.ndim == 2 else a
 
 
+def _dense_output(native, result, u_final):
+    """(times, u_times) of a run with output.times, from the run itself or its result.json."""
+    entry = result.get("dense_output")
+    if not entry:
+        return None, None
+    times = np.array(entry["times"], dtype=float)
+    states = native.get("u_times")
+    if states is None:  # read back: result.json holds small ones inline
+        states = [_state(u) if u is not None else None for u in entry["u"]] if isinstance(entry["u"], list) else None
+    if states is None or u_final is None:
+        return times, None
+    blank = np.full(np.shape(u_final), np.nan, dtype=np.asarray(u_final).dtype)
+    return times, np.stack([np.asarray(u) if u is not None else blank for u in states])
+
+
 def _columns(csv_text):
     """invariants.csv as a dict of numpy arrays, one per column (empty values are NaN)."""
     lines = csv_text.splitlines()
@@ -100,6 +115,8 @@ class RunResult:
 
     status       "completed", "blow-up", "failed" or "interrupted" (message says why)
     u_final      the final state in physical variables (numpy; complex for a complex model)
+    times, u_times   output.times and u there (numpy, one row per time, NaN where the run did
+                 not reach it); None without output.times
     error        the relative error against the reference (None without a reference)
     reference    the reference's final state (numpy), reference_info its settings and cost
     invariants   invariants.csv by column: t, H, I, m, err_H, err_I, err_m, tau_roughness,
@@ -124,6 +141,7 @@ class RunResult:
         self.u_final = native.get("u_final")
         if self.u_final is None:
             self.u_final = _state(self.result.get("u_final"))
+        self.times, self.u_times = _dense_output(native, self.result, self.u_final)
         err = self.result.get("error", {})
         self.error = err.get("relative")
         self.error_absolute = err.get("absolute")

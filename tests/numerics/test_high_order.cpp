@@ -208,7 +208,7 @@ TEST_CASE("compositions: classical order at eps = 1 and in the averaged regime, 
   CHECK(coarse / fine < 4.0);
 }
 
-TEST_CASE("collocation: one stage is SE1; three stages bound the error by C h^4 uniformly on Henon-Heiles") {
+TEST_CASE("collocation: one stage is SE1, three stages bound the error by C h^4 uniformly on Henon-Heiles") {
   for (double eps : {1.0, 1.0 / 64}) {
     const double se1 = hh_error({{"name", "se1"}, {"tol", 1e-14}}, eps, 8, 2);
     const double one_stage = hh_error({{"name", "collocation"}, {"stages", 1}, {"tol", 1e-14}}, eps, 8, 2);

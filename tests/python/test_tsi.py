@@ -47,6 +47,21 @@ class RunTests(unittest.TestCase):
         self.assertIn("se1", [s["name"] for s in listing["schemes"]])
         self.assertEqual([s["name"] for s in tsi.list("schemes")], [s["name"] for s in listing["schemes"]])
 
+    def test_output_times_give_u_between_the_steps(self):
+        config = with_(HH, output={"times": [1.0, 0.3, 0.0]})
+        config.pop("reference")
+        r = tsi.run(config)
+        np.testing.assert_array_equal(r.times, [1.0, 0.3, 0.0])
+        self.assertEqual(r.u_times.shape, (3, 4))
+        np.testing.assert_array_equal(r.u_times[0], r.u_final)  # t_end is the last step's u
+        self.assertTrue(np.all(np.isfinite(r.u_times)))
+        # The files hold the same values: result.json inline, u_times.npy one row per time.
+        with tempfile.TemporaryDirectory() as tmp:
+            tsi.run(config, out=tmp)
+            with open(os.path.join(tmp, "result.json")) as f:
+                np.testing.assert_array_equal(json.load(f)["dense_output"]["u"], r.u_times)
+            np.testing.assert_array_equal(np.load(os.path.join(tmp, "u_times.npy")), r.u_times)
+
     def test_run_returns_numpy_arrays_consistent_with_each_other(self):
         r = tsi.run(HH)
         self.assertEqual(r.status, "completed")

@@ -82,7 +82,7 @@ TEST_CASE("check: bad input is exit code 2 with a message") {
 
 }  // TEST_SUITE
 
-TEST_CASE("check: a stiff linear part folded into H1 fails with the measured cause; handed over, it passes") {
+TEST_CASE("check: a stiff linear part folded into H1 fails with the measured cause, handed over, it passes") {
   const std::string plugin = t::fixture_plugin("stiff");
   const t::CommandResult folded = t::run_tsi({"check", "fixture-stiff", "--plugin", plugin, "--set",
                                               "model.remainder=in-h1", "--scheme", "se2", "--eps", "1"});

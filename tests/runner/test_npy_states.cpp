@@ -66,7 +66,7 @@ t::Json large_nls_config() {
 
 TEST_SUITE("tsi_runner_tests") {
 
-TEST_CASE("npy states: u0 from a .npy file runs bit for bit as the same u0 in JSON; u_final.npy is result.json's u_final") {
+TEST_CASE("npy states: u0 from a .npy file runs bit for bit as the same u0 in JSON, u_final.npy is result.json's u_final") {
   for (const bool complex_model : {false, true}) {
     CAPTURE(complex_model);
     t::TempDir dir("tsi-npy-run");
@@ -169,7 +169,7 @@ np.save('hh.npy', np.array([[0.12, 0.12], [0.12, 0.12]]))
          dir.path());
 }
 
-TEST_CASE("npy states: a run that stops part-way writes u_final.npy of its last state; a stale reference file goes") {
+TEST_CASE("npy states: a run that stops part-way writes u_final.npy of its last state, a stale reference file goes") {
   t::TempDir dir("tsi-npy-run");
   t::Json config = hh_config();
   const t::CommandResult first = t::run_tsi({"run", t::write_config(dir, config), "--out", dir / "out"});

@@ -182,7 +182,7 @@ TEST_CASE("study: one --out holds one study: another is refused, the same one re
   CHECK(fs::exists(fs::path(out) / "runs" / "r0002" / "result.json"));  // untouched
 }
 
-TEST_CASE("study: --force replaces another study's results; --resume keeps the finished runs of the same one") {
+TEST_CASE("study: --force replaces another study's results, --resume keeps the finished runs of the same one") {
   TempDir dir;
   const Json first = {{"kind", "convergence"},
                       {"base", {{"model", {{"name", "hh"}}}, {"time", {{"t_end", 0.5}}}}},
