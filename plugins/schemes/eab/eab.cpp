@@ -6,10 +6,16 @@
 // values at t - h, ..., t - (r-1) h from the same interpolatory formula towards the past,
 // y(t - k h) = e^{-khL} y + h sum_j beta_j^{(-k)}(hL) N_{-j}, iterated r times from N_{-j} = N_0
 // (each pass gains one order in h), so the history is accurate to O(h^{r+1}).
+// Or HOODESolver.jl's start-up (startup = "hoodesolver"), stage by stage for q = 2 .. r: the
+// values u_{-1} .. u_{-(q-1)} backward with the formula of order q - 1 on the values after
+// them, then u_1 .. u_{q-1} forward with the formula of order q, N evaluated at each new value;
+// the run goes on from u_{r-1} (u_1 .. u_{r-1} are its first steps), the backward values
+// discarded. The same interpolatory weights, on the nodes 0, 1, .. (backward, kappa = -1).
 #include <array>
 #include <cmath>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "tsi/algebra.hpp"
@@ -25,9 +31,17 @@ using tsi::Vector;
 
 constexpr int max_order = 6;
 
+enum class Startup { interpolatory, hoodesolver };
+
+struct Settings {
+  int order = 4;
+  Startup startup = Startup::interpolatory;
+};
+
 class Eab final : public tsi::Stepper {
  public:
-  Eab(tsi::Problem& problem, double h, int order) : Stepper(problem, h), r_(order) {
+  Eab(tsi::Problem& problem, double h, const Settings& settings)
+      : Stepper(problem, h), r_(settings.order), startup_(settings.startup) {
     // The weights of N_{-j} for the value at kappa h: kappa = 1 the step, -k the start-up,
     // with the factor h folded in (one value per tau mode on the two-scale problem without a
     // remainder: tsi::Diagonal).
@@ -51,11 +65,27 @@ class Eab final : public tsi::Stepper {
     }
     history_.assign(r_, problem.new_state());
     past_.assign(r_ - 1, problem.new_state());
+    if (startup_ == Startup::hoodesolver && r_ > 1) prepare_stages(lambda, h);
   }
 
-  void reset() override { started_ = false; }
+  void reset() override {
+    started_ = false;
+    next_level_ = 0;
+  }
 
   void step(double t, Vector& y) override {
+    if (startup_ == Startup::hoodesolver && r_ > 1) {
+      // The start-up's forward values are the first steps.
+      if (!started_) {
+        start_by_stages(t, y);
+        next_level_ = 1;
+      }
+      if (next_level_ < r_) {
+        y.swap(forward_u_[static_cast<size_t>(next_level_ - 1)]);
+        ++next_level_;
+        return;
+      }
+    }
     if (!started_) start(t, y);
     combine(0, y, y);  // in place: the combination reads each entry before it writes it
     // The history moves back one place (swaps, no copies) and N_{n+1} takes the front.
@@ -63,10 +93,16 @@ class Eab final : public tsi::Stepper {
     problem_.nonlinear(t + h_, y, history_.front());
   }
 
-  double state_vectors() const override { return state_vectors_for(problem_.layout(), r_); }
-  // (r + 1) r coefficients; the history of r values of N and the start-up's r - 1 past values.
-  static double state_vectors_for(const tsi::ProblemLayout& layout, int r) {
-    return (r + 1.0) * r * layout.diagonal_fraction() + 2.0 * r - 1.0;
+  double state_vectors() const override { return state_vectors_for(problem_.layout(), {r_, startup_}); }
+  // (r + 1) r coefficients; the history of r values of N and the start-up's r - 1 past values;
+  // HOODESolver's start-up: 2 (r - 1) more (the backward values' N, the forward values), and
+  // its stages' coefficients, sum over q of q + (q - 1) and two exponentials.
+  static double state_vectors_for(const tsi::ProblemLayout& layout, const Settings& settings) {
+    const int r = settings.order;
+    double vectors = (r + 1.0) * r * layout.diagonal_fraction() + 2.0 * r - 1.0;
+    if (settings.startup == Startup::hoodesolver && r > 1)
+      vectors += 2.0 * (r - 1) + (static_cast<double>(r) * r + 1.0) * layout.diagonal_fraction();
+    return vectors;
   }
 
  private:
@@ -96,8 +132,85 @@ class Eab final : public tsi::Stepper {
     for (int j = 0; j < r; ++j) nodes[j] = -j;
     return nodes;
   }
+  static std::vector<double> future_nodes(int r) {
+    std::vector<double> nodes(r);
+    for (int j = 0; j < r; ++j) nodes[j] = j;
+    return nodes;
+  }
+
+  // HOODESolver's stages: for q = 2 .. r, the backward formula of order q - 1 (nodes 0 .. q - 2
+  // after the base, kappa = -1) and the forward one of order q (nodes 0 .. -(q - 1), kappa = 1).
+  void prepare_stages(const tsi::Diagonal& lambda, double h) {
+    tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(-z); }, backward_exponential_);
+    backward_.assign(r_ + 1, {});
+    forward_.assign(r_ + 1, {});
+    for (int q = 2; q <= r_; ++q) {
+      const auto weights = [&](std::vector<tsi::Diagonal>& out, std::vector<double> nodes, double kappa) {
+        const tsi::InterpolatoryWeights weights_of(std::move(nodes));
+        const int m = static_cast<int>(weights_of.nodes().size());
+        out.assign(m, tsi::Diagonal());
+        std::array<tsi::Diagonal*, max_order> outs{};
+        for (int j = 0; j < m; ++j) outs[j] = &out[j];
+        tsi::diagonal_functions(
+            lambda, h,
+            [&](Complex z) {
+              std::vector<Complex> w = weights_of(kappa, z);
+              for (Complex& x : w) x *= h;
+              return w;
+            },
+            std::span<tsi::Diagonal* const>(outs.data(), m));
+      };
+      weights(backward_[q], future_nodes(q - 1), -1.0);
+      if (q < r_) weights(forward_[q], past_nodes(q), 1.0);  // order r: the step's own weights
+    }
+    backward_u_.assign(r_ - 1, problem_.new_state());
+    backward_n_.assign(r_ - 1, problem_.new_state());
+    forward_u_.assign(r_ - 1, problem_.new_state());
+  }
+
+  // u at level m (y is level 0) and N there (levels 0 .. r - 1 in the history, newest first at
+  // the end: history_[r - 1 - m]).
+  Vector& level_u(int m, Vector& y) {
+    return m == 0 ? y : m < 0 ? backward_u_[static_cast<size_t>(-m - 1)] : forward_u_[static_cast<size_t>(m - 1)];
+  }
+  Vector& level_n(int m) {
+    return m < 0 ? backward_n_[static_cast<size_t>(-m - 1)] : history_[static_cast<size_t>(r_ - 1 - m)];
+  }
+
+  void start_by_stages(double t, Vector& y) {
+    problem_.nonlinear(t, y, level_n(0));
+    std::array<const tsi::Diagonal*, max_order + 1> d{};
+    std::array<const Vector*, max_order + 1> x{};
+    for (int q = 2; q <= r_; ++q) {
+      // Backward, order q - 1: u_{-k} from u_{-k+1} and N at -k+1 .. -k+q-1.
+      for (int k = 1; k <= q - 1; ++k) {
+        const int base = -k + 1;
+        d[0] = &backward_exponential_, x[0] = &level_u(base, y);
+        for (int j = 0; j < q - 1; ++j) d[j + 1] = &backward_[q][j], x[j + 1] = &level_n(base + j);
+        tsi::algebra::diagonal_linear_combination(nullptr, std::span<const tsi::Diagonal* const>(d.data(), q),
+                                                  std::span<const Vector* const>(x.data(), q), level_u(-k, y));
+        problem_.nonlinear(t - k * h_, level_u(-k, y), level_n(-k));
+      }
+      // Forward, order q: u_k from u_{k-1} and N at k-1 .. k-q.
+      const std::vector<tsi::Diagonal>& w = q < r_ ? forward_[q] : weights_[0];
+      for (int k = 1; k <= q - 1; ++k) {
+        const int base = k - 1;
+        d[0] = &exponentials_[0], x[0] = &level_u(base, y);
+        for (int j = 0; j < q; ++j) d[j + 1] = &w[j], x[j + 1] = &level_n(base - j);
+        tsi::algebra::diagonal_linear_combination(nullptr, std::span<const tsi::Diagonal* const>(d.data(), q + 1),
+                                                  std::span<const Vector* const>(x.data(), q + 1), level_u(k, y));
+        problem_.nonlinear(t + k * h_, level_u(k, y), level_n(k));
+      }
+    }
+    started_ = true;
+  }
 
   int r_;
+  Startup startup_;
+  int next_level_ = 0;  // HOODESolver's start-up: the next forward value a step returns
+  tsi::Diagonal backward_exponential_;                                 // e^{-hL}
+  std::vector<std::vector<tsi::Diagonal>> backward_, forward_;         // [q][j], see prepare_stages
+  std::vector<Vector> backward_u_, backward_n_, forward_u_;            // levels -1 .., and 1 .. r - 1
   bool started_ = false;
   std::vector<std::vector<tsi::Diagonal>> weights_;  // [k][j]: k = 0 the step, k >= 1 the value at -k h
   std::vector<tsi::Diagonal> exponentials_;          // [k]: e^{kappa_k h L}
@@ -126,13 +239,22 @@ void register_eab(tsi::Registry& registry) {
   entry.info.summary = "exponential Adams-Bashforth of order r (HOODESolver.jl's scheme), explicit, multistep";
   entry.info.params = {tsi::integer_param("order", 4, "the order r: r steps of history, one evaluation of N per step")
                            .check([](const tsi::Json& v) { return v.get<long>() >= 1 && v.get<long>() <= max_order; },
-                                  "an integer from 1 to 6")};
+                                  "an integer from 1 to 6"),
+                       tsi::string_param("startup", "tsi",
+                                         "the history's start-up: tsi (r passes of the interpolatory formula "
+                                         "backward from the initial value, r (r - 1) + 1 evaluations) or hoodesolver "
+                                         "(HOODESolver.jl's: stage by stage, backward then forward values, "
+                                         "(r - 1) r + 1 evaluations, the forward ones the first steps)")
+                           .choices({"tsi", "hoodesolver"})};
   entry.traits = traits_of_order(4);
   entry.traits_for = [](const tsi::Json& p) {
     return traits_of_order(p.contains("order") && p["order"].is_number_integer() ? p["order"].get<int>() : 4);
   };
   entry.create = [](const tsi::Params& p) {
-    return tsi::make_scheme<Eab>(p.has("order") ? static_cast<int>(p.integer("order")) : 4);
+    Settings settings;
+    if (p.has("order")) settings.order = static_cast<int>(p.integer("order"));
+    if (p.has("startup") && p.string("startup") == "hoodesolver") settings.startup = Startup::hoodesolver;
+    return tsi::make_scheme<Eab>(settings);
   };
   registry.add_scheme(std::move(entry));
 }
