@@ -16,6 +16,7 @@ computation runs with the GIL released; Ctrl-C stops it at its next step and rai
 tsi.Interrupted (a KeyboardInterrupt) carrying what was computed.
 """
 import builtins
+import itertools
 import json
 import math
 import os
@@ -291,6 +292,57 @@ def register_field(name, f=None, *, dim=0, time_dependent=False, is_complex=Fals
         return func
 
     return register if f is None else register(f)
+
+
+_solve_fields = itertools.count()
+
+
+def solve(A, f, eps, u0, t_span, *, scheme="eab", h=None, n_tau=32, times=None, time_dependent=True,
+          out=None, threads=None):
+    """u' = (1/eps) A u + f(t, u) from u(t0) = u0 over t_span = (t0, t1), as HOODESolver.jl's
+    solve: returns (t, u, result), t the times (the steps t0 + k h, or `times`), u the states
+    there (numpy, one row per time) and result the RunResult (its error, invariants, cost).
+
+        t, u, r = tsi.solve(A, lambda t, u: ..., 1e-4, [0.55, 0.12, 0.03, 0.89], (0, 3), h=0.1)
+
+    A: a matrix whose e^{2 pi A} is I (the "matrix" model; complex entries allowed). f(t, u): t an
+    array of n times, u the dim x n states, one per column; it returns an array of u's shape.
+    scheme: a scheme's name (default eab, order 4) or its config section ({"name": "eab",
+    "order": 6}). h: the step (default (t1 - t0) / 100, as HOODESolver.jl; rounded to a whole
+    number of steps). times: the times to return u at (any times in t_span: between the steps u
+    comes from the two-scale solution interpolated in t). time_dependent=False when f does not
+    use t (one variable fewer).
+    """
+    t0, t1 = float(t_span[0]), float(t_span[1])
+    if not t1 > t0:
+        raise ValueError(f"t_span: got ({t0}, {t1}), expected t0 < t1")
+    length = t1 - t0
+    steps = max(1, int(round(length / (length / 100 if h is None else float(h)))))
+    step = length / steps
+    A = np.asarray(A)
+    u0 = np.asarray(u0)
+    is_complex = bool(np.iscomplexobj(A) or np.iscomplexobj(u0))
+    # The field runs from t = 0: f at t0 + t (the equation is otherwise invariant under a shift in t).
+    name = f"tsi-solve-{next(_solve_fields)}"
+    register_field(name, lambda t, u: f(t + t0, u), dim=u0.size, time_dependent=time_dependent,
+                   is_complex=is_complex)
+    def entry(x):  # a number of the config: [re, im] for a complex model
+        z = complex(x)
+        return [z.real, z.imag] if is_complex else z.real
+
+    grid = t0 + step * np.arange(steps + 1)
+    wanted = grid if times is None else np.asarray(times, dtype=float)
+    config = {"model": {"name": "matrix", "eps": float(eps), "f": name,
+                        "A": [[entry(a) for a in row] for row in A.tolist()],
+                        "u0": [entry(x) for x in u0.ravel().tolist()]},
+              "reformulation": {"name": "two-scale", "n_tau": int(n_tau)},
+              "scheme": {"name": scheme} if isinstance(scheme, str) else dict(scheme),
+              "time": {"h": step, "t_end": length},
+              "output": {"times": [min(max(t - t0, 0.0), length) for t in wanted.tolist()]}}
+    result = run(config, out=out, threads=threads)
+    if not result.ok:
+        raise RuntimeError(f"tsi.solve: the run {result.status}: {result.message}")
+    return wanted, result.u_times, result
 
 
 def __getattr__(name):

@@ -455,6 +455,47 @@ def linear_f(t, u):
     return LINEAR_B @ u + np.outer(LINEAR_a, t) + LINEAR_b[:, None]
 
 
+class SolveTests(unittest.TestCase):
+    A = [[0, 0, 1, 0], [0, 0, 0, 0], [-1, 0, 0, 0], [0, 0, 0, 0]]
+
+    def test_solve_gives_hoodesolvers_quickstart_digits(self):
+        def f(t, u):
+            return np.array([0 * u[0], u[3], 2 * u[0] * u[1], -u[1] - u[0] ** 2 + u[1] ** 2])
+
+        t, u, r = tsi.solve(self.A, f, 1e-4, [0.55, 0.12, 0.03, 0.89], (0.0, 3.0), h=0.1,
+                            scheme={"name": "eab", "startup": "hoodesolver"}, time_dependent=False)
+        self.assertEqual(t.shape, (31,))
+        self.assertEqual(u.shape, (31, 4))
+        np.testing.assert_allclose(t, 0.1 * np.arange(31), rtol=0, atol=1e-14)
+        printed = [0.36354863065271914, 2.0384405589059846, -0.4134978102269046, 1.3093799931994603]
+        np.testing.assert_allclose(u[-1], printed, rtol=0, atol=1e-10)
+        np.testing.assert_array_equal(u[-1], r.u_final)
+
+    def test_solve_shifts_time_for_a_time_dependent_field(self):
+        # u4' = cos t from t0 = 1: u4(t) = u4(1) + sin t - sin 1; u2 stays; (u1, u3) turn.
+        def f(t, u):
+            return np.array([0 * u[0], 0 * u[1], 0 * u[2], np.cos(t)])
+
+        times = [1.0, 1.37, 2.0, 2.61]
+        exact = 0.5 + np.sin(times) - np.sin(1.0)
+        errors = []
+        for h in (0.05, 0.025):
+            t, u, r = tsi.solve(self.A, f, 1e-3, [0.3, 0.2, 0.1, 0.5], (1.0, 3.0), h=h, times=times)
+            np.testing.assert_array_equal(t, times)
+            errors.append(np.max(np.abs(u[:, 3] - exact)))
+            np.testing.assert_allclose(u[:, 1], 0.2, rtol=0, atol=1e-12)
+            # e^{(t - t0) A / eps} turns (u1, u3) = (0.3, 0.1) by (t - 1) / eps, exactly.
+            phase = (np.asarray(times) - 1.0) / 1e-3
+            np.testing.assert_allclose(u[:, 0], 0.3 * np.cos(phase) + 0.1 * np.sin(phase), rtol=0, atol=1e-9)
+        # eab of order 4 in the time variable t' = 1 (measured: 4.9e-7, then 16x less).
+        self.assertLess(errors[0], 1e-6)
+        self.assertGreater(errors[0] / errors[1], 12.0)
+
+    def test_solve_refuses_an_empty_span(self):
+        with self.assertRaises(ValueError):
+            tsi.solve(self.A, lambda t, u: 0 * u, 1e-3, [0, 0, 0, 0], (1.0, 1.0))
+
+
 class MatrixModelTests(unittest.TestCase):
     """The "matrix" model: A a matrix in the config, f a Python function (tsi.register_field)."""
 
