@@ -22,33 +22,29 @@ DenseOutput::DenseOutput(std::vector<double> times, int degree, double h, long n
     const long first = std::clamp(j - (degree_ - 1) / 2, 0L, std::max(0L, n_steps - degree_));
     pending_.push_back({k, first, std::min(first + degree_, n_steps)});
   }
-  std::sort(pending_.begin(), pending_.end(), [](const Pending& a, const Pending& b) { return a.last < b.last; });
+  std::sort(pending_.begin(), pending_.end(), [](const Pending& a, const Pending& b) {
+    return a.last < b.last || (a.last == b.last && a.first < b.first);
+  });
 }
 
 void DenseOutput::observe(long n, const Vector& y) {
   last_observed_ = n;
-  const bool needed = std::any_of(pending_.begin(), pending_.end(),
-                                  [n](const Pending& p) { return p.first <= n && n <= p.last; });
-  if (!needed) return;
+  // The stencils still pending start at pending_[next_].first or later (the firsts grow with
+  // the lasts), and n is below every later one's last: n is needed when the next one reaches it.
+  if (next_ == pending_.size() || n < pending_[next_].first) return;
   states_[n] = y;
-  while (!pending_.empty() && pending_.front().last <= n) {
-    evaluate(pending_.front(), n);
-    pending_.erase(pending_.begin());
-  }
+  for (; next_ < pending_.size() && pending_[next_].last <= n; ++next_) evaluate(pending_[next_], n);
   // Steps no pending stencil reaches back to are dropped.
-  const long keep_from = pending_.empty() ? n + 1
-                                          : std::min_element(pending_.begin(), pending_.end(),
-                                                             [](const Pending& a, const Pending& b) {
-                                                               return a.first < b.first;
-                                                             })->first;
+  const long keep_from = next_ == pending_.size() ? n + 1 : pending_[next_].first;
   states_.erase(states_.begin(), states_.lower_bound(keep_from));
 }
 
 void DenseOutput::finish() {
   const long last = last_observed_;
-  for (const Pending& p : pending_)
+  for (; next_ < pending_.size(); ++next_) {
+    const Pending& p = pending_[next_];
     if (last >= 0 && times_[p.index] <= step_time(last, h_) && p.first <= last) evaluate(p, last);
-  pending_.clear();
+  }
   states_.clear();
 }
 

@@ -12,7 +12,8 @@ namespace tsi::app {
 /// through p + 1 consecutive steps around the time (p the scheme's order: the interpolation's
 /// error O(h^(p+1)) stays below the scheme's O(h^p)), then read back at tau = t/eps as at a step
 /// (Reformulation::read_back). A step's state is kept only while a pending time's stencil needs
-/// it; a time is evaluated as soon as its stencil's last step is computed.
+/// it; a time is evaluated as soon as its stencil's last step is computed. A step costs O(1)
+/// besides the evaluations, however many times are asked.
 class DenseOutput {
  public:
   /// `times` in [0, t_end] (any order; the values come back in the same order), steps of size
@@ -44,7 +45,10 @@ class DenseOutput {
   double h_;
   const Model& model_;
   Reformulation& reformulation_;
-  std::vector<Pending> pending_;  // by the stencil's last step
+  // By the stencil's last step (and so by its first: both grow with the time); the ones from
+  // next_ on are still to be evaluated.
+  std::vector<Pending> pending_;
+  std::size_t next_ = 0;
   std::map<long, Vector> states_;  // the steps a pending stencil needs
   std::vector<Vector> values_;
   long last_observed_ = -1;
