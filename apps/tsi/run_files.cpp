@@ -29,16 +29,20 @@ void prepare_output_dir(const std::string& dir) {
 
 namespace {
 
+// The file shape of one state of n values: the outcome's (model.u0's file's) where it holds n
+// values, else (n,).
+std::vector<std::uint64_t> one_state_shape(const RunOutcome& outcome, std::uint64_t n) {
+  std::uint64_t product = 1;
+  for (const std::uint64_t d : outcome.state_shape) product *= d;
+  return outcome.state_shape.empty() || product != n ? std::vector<std::uint64_t>{n} : outcome.state_shape;
+}
+
 // Writes one state file of a run, or removes a stale one a previous run left in DIR when this
 // outcome has no such state (a run that never started); an outcome read back from its files
 // (--resume: it has the entry in result.json but no state in memory) leaves the file alone.
 void write_state_file(const std::string& path, const Vector& x, const RunOutcome& outcome, bool has_entry) {
   if (x.size() > 0) {
-    const std::uint64_t n = static_cast<std::uint64_t>(x.size());
-    std::uint64_t product = 1;
-    for (const std::uint64_t d : outcome.state_shape) product *= d;
-    write_npy(path, x, outcome.complex_state,
-              outcome.state_shape.empty() || product != n ? std::vector<std::uint64_t>{n} : outcome.state_shape);
+    write_npy(path, x, outcome.complex_state, one_state_shape(outcome, static_cast<std::uint64_t>(x.size())));
   } else if (!has_entry) {
     std::error_code ec;
     std::filesystem::remove(path, ec);
@@ -69,12 +73,8 @@ void write_run_files(const std::string& dir, const RunOutcome& outcome) {
                 ? outcome.u_times[k]
                 : Vector::Constant(per_time, Complex(std::numeric_limits<double>::quiet_NaN(), 0.0));
       std::vector<std::uint64_t> shape = {outcome.u_times.size()};
-      std::uint64_t product = 1;
-      for (const std::uint64_t d : outcome.state_shape) product *= d;
-      if (!outcome.state_shape.empty() && product == static_cast<std::uint64_t>(per_time))
-        shape.insert(shape.end(), outcome.state_shape.begin(), outcome.state_shape.end());
-      else
-        shape.push_back(static_cast<std::uint64_t>(per_time));
+      const std::vector<std::uint64_t> one = one_state_shape(outcome, static_cast<std::uint64_t>(per_time));
+      shape.insert(shape.end(), one.begin(), one.end());
       write_npy(dir + "/" + u_times_file, all, outcome.complex_state, shape);
     }
   } catch (const IoError& e) {

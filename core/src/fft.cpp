@@ -128,32 +128,26 @@ void FftBatch::transform(const Complex* from, Complex* to, int direction, double
     // The in-place plans run on `to` itself where it has the alignment they were made with:
     // one copy (from -> to) instead of two through the buffer.
     const auto alignment = [](const Complex* p) { return fftw_alignment_of(reinterpret_cast<double*>(const_cast<Complex*>(p))); };
-    if (to != buffer_ && alignment(to + r0) == alignment(buffer_ + r0)) {
-      if (rows == howmany_) {  // the whole array: contiguous passes (a block of rows is strided)
-        const Index size = static_cast<Index>(howmany_) * n_;
-        if (from != to) std::copy(from, from + size, to);
-        if (shift) Eigen::Map<Vector>(to, howmany_) += Eigen::Map<const Vector>(shift, howmany_);
-        fftw_execute_dft(as_plan(plan), raw(to), raw(to));
-        if (scale != 1.0) Eigen::Map<RealVector>(reinterpret_cast<double*>(to), 2 * size) *= scale;
-        return;
-      }
+    const bool on_to = to != buffer_ && alignment(to + r0) == alignment(buffer_ + r0);
+    if (rows == howmany_) {  // the whole array: contiguous passes (a block of rows is strided)
+      Complex* work = on_to ? to : buffer_;
+      const Index size = static_cast<Index>(howmany_) * n_;
+      if (from != work) std::copy(from, from + size, work);
+      if (shift) Eigen::Map<Vector>(work, howmany_) += Eigen::Map<const Vector>(shift, howmany_);
+      fftw_execute_dft(as_plan(plan), raw(work), raw(work));
+      if (scale != 1.0)  // the doubles scaled: a real factor, not a complex product
+        Eigen::Map<RealVector>(reinterpret_cast<double*>(to), 2 * size) =
+            Eigen::Map<const RealVector>(reinterpret_cast<const double*>(work), 2 * size) * scale;
+      else if (to != work)
+        std::copy(work, work + size, to);
+      return;
+    }
+    if (on_to) {
       auto rows_of_to = Eigen::Map<Matrix>(to, howmany_, n_).middleRows(r0, rows);
       if (from != to) rows_of_to = Eigen::Map<const Matrix>(from, howmany_, n_).middleRows(r0, rows);
       if (shift) rows_of_to.col(0) += Eigen::Map<const Vector>(shift, howmany_).segment(r0, rows);
       fftw_execute_dft(as_plan(plan), raw(to + r0), raw(to + r0));
       if (scale != 1.0) rows_of_to *= scale;
-      return;
-    }
-    if (rows == howmany_) {
-      const Index size = static_cast<Index>(howmany_) * n_;
-      if (from != buffer_) std::copy(from, from + size, buffer_);
-      if (shift) Eigen::Map<Vector>(buffer_, howmany_) += Eigen::Map<const Vector>(shift, howmany_);
-      fftw_execute(as_plan(plan));
-      if (scale != 1.0)
-        Eigen::Map<RealVector>(reinterpret_cast<double*>(to), 2 * size) =
-            Eigen::Map<const RealVector>(reinterpret_cast<const double*>(buffer_), 2 * size) * scale;
-      else if (to != buffer_)
-        std::copy(buffer_, buffer_ + size, to);
       return;
     }
     Eigen::Map<Matrix> buf = data();

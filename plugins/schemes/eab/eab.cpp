@@ -47,21 +47,12 @@ class Eab final : public tsi::Stepper {
     // remainder: tsi::Diagonal).
     const tsi::InterpolatoryWeights weights_of(past_nodes(r_));
     const tsi::Diagonal& lambda = problem.linear_multipliers();
-    weights_.assign(r_, std::vector<tsi::Diagonal>(r_));
+    weights_.assign(r_, {});
     exponentials_.assign(r_, tsi::Diagonal());
     for (int k = 0; k < r_; ++k) {
       const double kappa = k == 0 ? 1.0 : -static_cast<double>(k);
       tsi::diagonal_function(lambda, h, [kappa](Complex z) { return std::exp(kappa * z); }, exponentials_[k]);
-      std::array<tsi::Diagonal*, max_order> outs{};
-      for (int j = 0; j < r_; ++j) outs[j] = &weights_[k][j];
-      tsi::diagonal_functions(
-          lambda, h,
-          [&](Complex z) {
-            std::vector<Complex> w = weights_of(kappa, z);
-            for (Complex& x : w) x *= h;
-            return w;
-          },
-          std::span<tsi::Diagonal* const>(outs.data(), r_));
+      scaled_weights(lambda, h, weights_of, kappa, weights_[k]);
     }
     history_.assign(r_, problem.new_state());
     past_.assign(r_ - 1, problem.new_state());
@@ -132,6 +123,22 @@ class Eab final : public tsi::Stepper {
     for (int j = 0; j < r; ++j) nodes[j] = -j;
     return nodes;
   }
+  // h w_j(kappa, hL) for every node of weights_of, one Diagonal each (the factor h folded in).
+  static void scaled_weights(const tsi::Diagonal& lambda, double h, const tsi::InterpolatoryWeights& weights_of,
+                             double kappa, std::vector<tsi::Diagonal>& out) {
+    const int m = static_cast<int>(weights_of.nodes().size());
+    out.assign(m, tsi::Diagonal());
+    std::array<tsi::Diagonal*, max_order> outs{};
+    for (int j = 0; j < m; ++j) outs[j] = &out[j];
+    tsi::diagonal_functions(
+        lambda, h,
+        [&](Complex z) {
+          std::vector<Complex> w = weights_of(kappa, z);
+          for (Complex& x : w) x *= h;
+          return w;
+        },
+        std::span<tsi::Diagonal* const>(outs.data(), m));
+  }
   static std::vector<double> future_nodes(int r) {
     std::vector<double> nodes(r);
     for (int j = 0; j < r; ++j) nodes[j] = j;
@@ -145,23 +152,9 @@ class Eab final : public tsi::Stepper {
     backward_.assign(r_ + 1, {});
     forward_.assign(r_ + 1, {});
     for (int q = 2; q <= r_; ++q) {
-      const auto weights = [&](std::vector<tsi::Diagonal>& out, std::vector<double> nodes, double kappa) {
-        const tsi::InterpolatoryWeights weights_of(std::move(nodes));
-        const int m = static_cast<int>(weights_of.nodes().size());
-        out.assign(m, tsi::Diagonal());
-        std::array<tsi::Diagonal*, max_order> outs{};
-        for (int j = 0; j < m; ++j) outs[j] = &out[j];
-        tsi::diagonal_functions(
-            lambda, h,
-            [&](Complex z) {
-              std::vector<Complex> w = weights_of(kappa, z);
-              for (Complex& x : w) x *= h;
-              return w;
-            },
-            std::span<tsi::Diagonal* const>(outs.data(), m));
-      };
-      weights(backward_[q], future_nodes(q - 1), -1.0);
-      if (q < r_) weights(forward_[q], past_nodes(q), 1.0);  // order r: the step's own weights
+      scaled_weights(lambda, h, tsi::InterpolatoryWeights(future_nodes(q - 1)), -1.0, backward_[q]);
+      if (q < r_)  // order r: the step's own weights
+        scaled_weights(lambda, h, tsi::InterpolatoryWeights(past_nodes(q)), 1.0, forward_[q]);
     }
     backward_u_.assign(r_ - 1, problem_.new_state());
     backward_n_.assign(r_ - 1, problem_.new_state());

@@ -52,18 +52,14 @@ class Se1 final : public tsi::Stepper {
     else
       algebra::diagonal_multiply(c_.e_half, y, y_half_);
     const double t_half = t + 0.5 * h_;
-    if (base_.size()) {
-      algebra::diagonal_multiply(c_.e_half, y, base_);
-      solver_->solve(y_half_, [&](const Vector& x, Vector& out) {
-        problem_.nonlinear(t_half, x, n_half_);
+    if (base_.size()) algebra::diagonal_multiply(c_.e_half, y, base_);
+    solver_->solve(y_half_, [&](const Vector& x, Vector& out) {
+      problem_.nonlinear(t_half, x, n_half_);
+      if (base_.size())
         algebra::diagonal_multiply_add(base_, c_.b_half, n_half_, out);
-      });
-    } else {
-      solver_->solve(y_half_, [&](const Vector& x, Vector& out) {
-        problem_.nonlinear(t_half, x, n_half_);
+      else
         algebra::diagonal_combination(c_.e_half, y, c_.b_half, n_half_, out);
-      });
-    }
+    });
     // n_half_ = N at the last-but-one iterate, within tol of N(U^{n+1/2}).
     algebra::diagonal_combination(c_.e_full, y, c_.b_full, n_half_, y);
     guess_.stored();
