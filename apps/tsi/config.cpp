@@ -43,7 +43,9 @@ const ParamSchema& time_schema() {
 
 const ParamSchema& reference_schema() {
   static const ParamSchema schema = {
-      string_param("scheme", "rk78", "the reference solver"),
+      string_param("scheme", "rk78",
+                   "the reference solver, or \"exact\": the model's exact solution where it declares one (the "
+                   "matrix model with an affine field such as \"linear\"; the other keys are then unused)"),
       string_param("reformulation", "filtered", "the problem the reference solver integrates"),
       number_param("tol", 1e-13, "the reference solver's tolerance").range(1e-16, 1e-1),
       number_param("h", nullptr, "step of a non-adaptive reference solver; default: t_end")
@@ -53,6 +55,38 @@ const ParamSchema& reference_schema() {
                  "substeps per fast period (at least what rounding its state in model variables "
                  "causes)")};
   return schema;
+}
+
+// The reference section, resolved: a scheme on a reformulation that it can integrate, with its
+// step where it is not adaptive; or "exact" alone (whether the model has one, run.cpp checks).
+Json resolve_reference(const Json& raw, double t_end, const Registry& registry) {
+  const Json empty = Json::object();
+  Json ref = resolve_params(reference_schema(), section_object(raw, "reference", empty), "reference");
+  if (ref["scheme"] == exact_reference) return Json{{"scheme", exact_reference}};
+  const SchemeEntry& ref_scheme = registry.scheme(ref["scheme"], "reference.scheme");
+  const ReformulationEntry& ref_reform = registry.reformulation(ref["reformulation"], "reference.reformulation");
+  try {
+    registry.check_compatible(ref_scheme, ref_reform);
+  } catch (const ConfigError& e) {
+    throw ConfigError("reference.reformulation", e.what());
+  }
+  ref["scheme"] = ref_scheme.info.name;
+  ref["reformulation"] = ref_reform.info.name;
+  if (!ref_scheme.traits.adaptive && ref["h"].is_null())
+    throw ConfigError("reference.h", "the reference scheme \"" + ref_scheme.info.name +
+                                         "\" is not adaptive: give its step h");
+  if (ref["h"].is_number()) {  // a reference step that does not divide t_end would run another step
+    const double h = ref["h"];
+    const double steps = t_end / h;
+    if (t_end > 0.0 && (!(h <= t_end) || std::abs(steps - std::round(steps)) > 1e-9 * std::max(1.0, steps)))
+      throw ConfigError("reference.h", fmt::format("got {}, expected t_end / n for a whole number n of steps "
+                                                   "(t_end = {}: {:.6g} steps)",
+                                                   h, t_end, steps));
+    if (steps > 1e12)
+      throw ConfigError("reference.h",
+                        fmt::format("t_end / h = {:.3g} steps is too many: at most 1e12, the largest --max-steps", steps));
+  }
+  return ref;
 }
 
 const ParamSchema& output_schema() {
@@ -224,32 +258,8 @@ Json resolve_run_config(const Json& raw, const Registry& registry) {
   out["time"] = resolve_params(time_schema(), section_object(raw, "time", empty), "time");
   step_count(out);  // t_end must be a whole number of steps
 
-  if (raw.contains("reference") && !raw.at("reference").is_null()) {
-    Json ref = resolve_params(reference_schema(), section_object(raw, "reference", empty), "reference");
-    const SchemeEntry& ref_scheme = registry.scheme(ref["scheme"], "reference.scheme");
-    const ReformulationEntry& ref_reform =
-        registry.reformulation(ref["reformulation"], "reference.reformulation");
-    try {
-      registry.check_compatible(ref_scheme, ref_reform);
-    } catch (const ConfigError& e) {
-      throw ConfigError("reference.reformulation", e.what());
-    }
-    ref["scheme"] = ref_scheme.info.name;
-    ref["reformulation"] = ref_reform.info.name;
-    if (!ref_scheme.traits.adaptive && ref["h"].is_null())
-      throw ConfigError("reference.h", "the reference scheme \"" + ref_scheme.info.name +
-                                           "\" is not adaptive: give its step h");
-    if (ref["h"].is_number()) {  // a reference step that does not divide t_end would run another step
-      const double t_end = out["time"]["t_end"], h = ref["h"];
-      const double steps = t_end / h;
-      if (t_end > 0.0 && (!(h <= t_end) || std::abs(steps - std::round(steps)) > 1e-9 * std::max(1.0, steps)))
-        throw ConfigError("reference.h", fmt::format("got {}, expected t_end / n for a whole number n of steps "
-                                                     "(t_end = {}: {:.6g} steps)",
-                                                     h, t_end, steps));
-      if (steps > 1e12) throw ConfigError("reference.h", fmt::format("t_end / h = {:.3g} steps is too many: at most 1e12, the largest --max-steps", steps));
-    }
-    out["reference"] = ref;
-  }
+  if (raw.contains("reference") && !raw.at("reference").is_null())
+    out["reference"] = resolve_reference(raw, out["time"]["t_end"], registry);
 
   out["output"] = resolve_params(output_schema(), section_object(raw, "output", empty), "output");
   out["monitor"] = resolve_params(monitor_schema(), section_object(raw, "monitor", empty), "monitor");

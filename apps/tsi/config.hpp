@@ -10,6 +10,8 @@ namespace tsi::app {
 
 /// The most times output.times may list.
 inline constexpr std::size_t max_output_times = 100000;
+/// reference.scheme's value that asks for the model's exact solution instead of a solver.
+inline constexpr const char* exact_reference = "exact";
 
 /// Parses JSON strictly: a duplicated key, nesting deeper than 64 levels or a number beyond a
 /// double is a ConfigError naming where (`origin`, then the key path).

@@ -111,8 +111,31 @@ void check_work_estimate(const Json& config, const Registry& registry, const Run
   if (config.contains("reference")) check_reference_cost(config, registry, settings);
 }
 
+namespace {
+
+// The model of a config whose reference is "exact", refused (ConfigError naming
+// reference.scheme) when it declares no exact solution.
+std::shared_ptr<const Model> model_with_exact_solution(const Json& config, const Registry& registry,
+                                                       const RunSettings& settings) {
+  std::shared_ptr<const Model> model =
+      registry.model(config["model"]["name"]).create(Params(without_name(config["model"]), settings.context));
+  if (!model->exact_solution())
+    throw ConfigError("reference.scheme",
+                      fmt::format("got \"{}\", but the model \"{}\" declares no exact solution (the matrix model has "
+                                  "one with an affine field such as \"linear\"); choose a reference solver, e.g. "
+                                  "\"rk78\"",
+                                  exact_reference, config["model"]["name"].get<std::string>()));
+  return model;
+}
+
+}  // namespace
+
 void check_reference_cost(const Json& config, const Registry& registry, const RunSettings& settings) {
   const Json& ref = config["reference"];
+  if (ref["scheme"] == exact_reference) {
+    model_with_exact_solution(config, registry, settings);
+    return;
+  }
   const Json scheme_section =
       reference_scheme_section(ref, registry.scheme(ref["scheme"], "reference.scheme"), 1.0, 1.0);
   check_reference_cost(config, reference_assembly(config, registry, scheme_section, settings), scheme_section,
@@ -173,6 +196,15 @@ ReferenceSolution compute_reference(const Json& config, const Registry& registry
   ReferenceSolution out;
   out.settings = config["reference"];
   const auto start = Clock::now();
+  if (out.settings["scheme"] == exact_reference) {
+    const std::shared_ptr<const Model> model = model_with_exact_solution(config, registry, settings);
+    const Vector x0 = model->to_physical(initial_value(*model, config["model"]));
+    const ExactSolution::Value exact = model->exact_solution()->at(x0, config["time"]["t_end"].get<double>());
+    out.x = exact.x;
+    out.accuracy = exact.accuracy;
+    out.wall_seconds = seconds_since(start);
+    return out;
+  }
   const Vector u = reference_model_state(config, registry, settings, 1.0, 1.0, progress, "reference");  // its cost checked first
   std::shared_ptr<const Model> model =
       registry.model(config["model"]["name"]).create(Params(without_name(config["model"]), settings.context));

@@ -8,9 +8,11 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "tsi/affine_exact.hpp"
 #include "tsi/error.hpp"
 #include "tsi/registry.hpp"
 
@@ -158,7 +160,12 @@ class MatrixModel final : public Model {
         time_(time_dependent),
         complex_(is_complex),
         u0_(std::move(u0)),
-        field_name_(std::move(field_name)) {}
+        field_name_(std::move(field_name)) {
+    // An affine f (B u + t a + b) has an exact solution; with t not carried, only where a = 0.
+    const AffineTerms* terms = field_->affine_terms();
+    if (terms && d_ <= max_affine_exact_dim && terms->B.rows() == d_ && (time_ || terms->a.isZero(0.0)))
+      exact_ = AffineExact(flow_.A(), this->eps(), *terms);
+  }
 
   Index dim() const override { return d_ + (time_ ? 1 : 0); }
   Index physical_dim() const override { return d_; }
@@ -238,6 +245,8 @@ class MatrixModel final : public Model {
     return std::make_unique<GridField>(*this, taus);
   }
 
+  const ExactSolution* exact_solution() const override { return exact_ ? &*exact_ : nullptr; }
+
   Vector initial_value() const override {
     if (u0_.size() != d_)
       throw ConfigError("model.u0", fmt::format("the field \"{}\" gives no default initial value for this A: give "
@@ -262,7 +271,19 @@ class MatrixModel final : public Model {
     return t;
   }
 
+  class AffineExact final : public ExactSolution {
+   public:
+    AffineExact(Matrix A, double eps, AffineTerms terms) : A_(std::move(A)), eps_(eps), terms_(std::move(terms)) {}
+    Value at(const Vector& x0, double t) const override { return affine_exact_solution(A_, eps_, terms_, x0, t); }
+
+   private:
+    Matrix A_;
+    double eps_;
+    AffineTerms terms_;
+  };
+
   PeriodicMatrixFlow flow_;
+  std::optional<AffineExact> exact_;
   std::shared_ptr<const Field> field_;
   Index d_;
   bool time_, complex_;
@@ -292,6 +313,32 @@ class QuickstartField final : public Field {
   }
 };
 
+// HOODESolver.jl's linear test f(t, u) = B u + t a + b (its values: the parity issue; exact
+// solution: SPEC.md section 7).
+class LinearTestField final : public Field {
+ public:
+  LinearTestField() {
+    terms_.B = Matrix(4, 4);
+    terms_.B << 0.12, -0.78, 0.91, 0.34, -0.45, 0.56, 0.03, 0.54, -0.67, 0.09, 0.18, 0.89, -0.91, -0.56, 0.11, -0.56;
+    terms_.a = Vector(4);
+    terms_.a << 0.12, -0.98, 0.45, 0.26;
+    terms_.b = Vector(4);
+    terms_.b << -0.04, 0.48, 0.23, -0.87;
+  }
+  void evaluate(const RealVector& t, ConstMatrixRef u, MatrixRef out) const override {
+    out.noalias() = terms_.B * u;
+    for (Index j = 0; j < u.cols(); ++j) out.col(j) += t(j) * terms_.a + terms_.b;
+  }
+  bool has_derivative() const override { return true; }
+  void derivative(const RealVector&, ConstMatrixRef, ConstMatrixRef z, MatrixRef out) const override {
+    out.noalias() = terms_.B * z;
+  }
+  const AffineTerms* affine_terms() const override { return &terms_; }
+
+ private:
+  AffineTerms terms_;
+};
+
 Json quickstart_A() {
   return Json::array({Json::array({0, 0, 1, 0}), Json::array({0, 0, 0, 0}), Json::array({-1, 0, 0, 0}),
                       Json::array({0, 0, 0, 0})});
@@ -317,10 +364,21 @@ void register_matrix_model(Registry& registry) {
   quickstart.create = [](Index) { return std::make_shared<QuickstartField>(); };
   registry.add_field(std::move(quickstart));
 
+  FieldEntry linear;
+  linear.info.name = "linear";
+  linear.info.summary = "HOODESolver.jl's linear test f(t, u) = B u + t a + b, 4 entries, default u0 "
+                        "(-0.34, 0.78, 0.67, -5.6); exact solution (reference.scheme \"exact\")";
+  linear.dim = 4;
+  linear.time_dependent = true;
+  linear.initial_value = Vector(4);
+  linear.initial_value << -0.34, 0.78, 0.67, -5.6;
+  linear.create = [](Index) { return std::make_shared<LinearTestField>(); };
+  registry.add_field(std::move(linear));
+
   ModelEntry entry;
   entry.info.name = "matrix";
   entry.info.summary = "u' = (1/eps) A u + f(t, u) with A a 2 pi-periodic matrix given in the run's JSON and f a "
-                       "registered field (model.f: a plugin's, Python's tsi.register_field, or \"quickstart\")";
+                       "registered field (model.f: a plugin's, Python's tsi.register_field, \"quickstart\" or \"linear\")";
   ParamSpec a = array_param("A", "the matrix A (rows of numbers, [re, im] for complex ones); e^(2 pi A) must be I. "
                                  "Default: HOODESolver.jl's quickstart A, turning (u1, u3)");
   a.default_value = quickstart_A();

@@ -164,6 +164,78 @@ TEST_CASE("matrix model: a time-dependent f converges at the schemes' orders to 
   }
 }
 
+TEST_CASE("matrix model: against the linear test's exact solution eab of orders 3 to 6 is uniform in eps") {
+  // The core's "linear" field with reference.scheme "exact" (quad precision). Order r of the
+  // envelope over eps = 0.15, 1.5e-4, 1.5e-7 (h = 1/8 .. 1/64: below the ratio of its errors at
+  // 1/4 and 1/8 is still pre-asymptotic at eps = 0.15), and each eps alone; collocation (s = 3,
+  // uniform order 2 declared) keeps its envelope under its h = 1/4 error times (4 h)^2.
+  t::TempDir dir;
+  const std::vector<double> epsilons = {0.15, 1.5e-4, 1.5e-7};
+  int runs = 0;
+  auto error = [&](const Json& scheme, double eps, double h) {
+    Json cfg = config({{"name", "matrix"}, {"eps", eps}, {"f", "linear"}}, scheme, h, 1.0);
+    cfg["reference"] = {{"scheme", "exact"}};
+    const std::string name = fmt::format("run-{}", runs++);
+    const std::string out = dir / name;
+    const t::CommandResult r = t::run_tsi({"run", t::write_config(dir, cfg, name + ".json"), "--out", out});
+    INFO(r.describe());
+    REQUIRE(r.exit_code == 0);
+    const Json result = t::read_json(t::fs::path(out) / "result.json");
+    REQUIRE(result["error"]["reference"]["scheme"] == "exact");
+    CHECK(result["error"]["reference"]["estimated_relative_accuracy"].get<double>() < 2e-16);
+    return result["error"]["relative"].get<double>();
+  };
+  auto slope = [](const std::vector<double>& hs, const std::vector<double>& errors) {
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    const auto n = static_cast<double>(hs.size());
+    for (std::size_t i = 0; i < hs.size(); ++i) {
+      const double x = std::log(hs[i]), y = std::log(errors[i]);
+      sx += x, sy += y, sxx += x * x, sxy += x * y;
+    }
+    return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  };
+  const std::vector<double> hs = {1.0 / 8, 1.0 / 16, 1.0 / 32, 1.0 / 64};
+  for (int r = 3; r <= 6; ++r) {
+    const Json scheme = {{"name", "eab"}, {"order", r}};
+    std::vector<double> envelope(hs.size(), 0.0);
+    for (const double eps : epsilons) {
+      std::vector<double> errors;
+      for (std::size_t i = 0; i < hs.size(); ++i) {
+        errors.push_back(error(scheme, eps, hs[i]));
+        envelope[i] = std::max(envelope[i], errors.back());
+      }
+      const double order = slope(hs, errors);
+      MESSAGE("eab r = " << r << ", eps = " << eps << ": errors " << errors[0] << " .. " << errors.back() << ", order "
+                         << order);
+      CHECK(order == doctest::Approx(r).epsilon(0.06));
+    }
+    const double order = slope(hs, envelope);
+    MESSAGE("eab r = " << r << ": order of the envelope " << order);
+    CHECK(order == doctest::Approx(r).epsilon(0.06));
+  }
+  const Json collocation = {{"name", "collocation"}, {"stages", 3}, {"tol", 1e-15}, {"max_iter", 1000}};
+  const std::vector<double> coarse = {1.0 / 4, 1.0 / 8, 1.0 / 16, 1.0 / 32};
+  std::vector<double> envelope(coarse.size(), 0.0);
+  for (const double eps : epsilons)
+    for (std::size_t i = 0; i < coarse.size(); ++i) envelope[i] = std::max(envelope[i], error(collocation, eps, coarse[i]));
+  for (std::size_t i = 1; i < coarse.size(); ++i) {
+    MESSAGE("collocation h = " << coarse[i] << ": envelope " << envelope[i] << ", order-2 bound "
+                               << envelope[0] * std::pow(4.0 * coarse[i], 2.0));
+    CHECK(envelope[i] <= envelope[0] * std::pow(4.0 * coarse[i], 2.0));
+  }
+}
+
+TEST_CASE("matrix model: an exact reference is refused for a model that declares none") {
+  t::TempDir dir;
+  Json cfg = config({{"name", "matrix"}, {"eps", 1e-2}}, {{"name", "se1"}}, 0.1, 1.0);
+  cfg["reference"] = {{"scheme", "exact"}};
+  const t::CommandResult r = t::run_tsi({"run", t::write_config(dir, cfg), "--out", dir / "out"});
+  INFO(r.describe());
+  CHECK(r.exit_code == 2);
+  CHECK(t::contains(r.err, "tsi: error: reference.scheme: got \"exact\", but the model \"matrix\" declares no exact "
+                           "solution"));
+}
+
 TEST_CASE("matrix model: the fields are listed") {
   const t::CommandResult r = t::run_tsi({"--plugin", t::fixture_plugin("general"), "list", "fields"});
   INFO(r.describe());

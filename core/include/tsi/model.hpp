@@ -39,6 +39,19 @@ struct TSI_API ModelInvariant {
   std::function<double(const Vector& u)> value;  ///< of a state in model variables
 };
 
+/// An exact solution of a model's equation, where the model knows one (the matrix model with
+/// an affine field): a reference without discretisation error (a run's reference.scheme "exact").
+class TSI_API ExactSolution {
+ public:
+  virtual ~ExactSolution() = default;
+  struct Value {
+    Vector x;         ///< u(t), physical variables
+    double accuracy;  ///< its estimated relative error (at least the rounding of x to double)
+  };
+  /// u(t) from u(0) = x0, both in physical variables, for t >= 0.
+  virtual Value at(const Vector& x0, double t) const = 0;
+};
+
 /// The general class u' = (1/eps) A u + R u + f(u) (SPEC.md section 7): a model gives the
 /// action of e^{A tau} (2 pi-periodic), an optional remainder R and f. Most models have the
 /// Hamiltonian structure of the paper's class (eq. model), which they declare
@@ -132,6 +145,9 @@ class TSI_API Model {
   virtual bool has_exact_nonlinear_flow() const { return false; }
   /// u <- the exact flow of u' = J grad H1(u) over time t. The default throws tsi::Error.
   virtual void nonlinear_flow(double t, Vector& u) const;
+
+  /// The exact solution, when the model declares one (null by default).
+  virtual const ExactSolution* exact_solution() const { return nullptr; }
 
   /// The model's default initial value u0 (model variables).
   virtual Vector initial_value() const = 0;

@@ -1,0 +1,25 @@
+#pragma once
+#include "tsi/export.hpp"
+#include "tsi/field.hpp"
+#include "tsi/model.hpp"
+#include "tsi/types.hpp"
+
+namespace tsi {
+
+/// The largest n for which affine_exact_solution is offered: its arithmetic is quadruple
+/// precision in software, O(n^3) per squaring.
+inline constexpr Index max_affine_exact_dim = 32;
+
+/// The exact solution of u' = C u + t a + b, u(0) = u0, with C = A / eps + B (SPEC.md section 7):
+/// u(t) is the first n entries of e^{t Z} (u0, 0, 1) for the augmented matrix
+/// Z = [[C, a, b], [0, 0, 1], [0, 0, 0]]. e^{t Z} is computed in quadruple precision (__float128)
+/// by scaling and squaring a Taylor polynomial, since |t C| reaches 1e7 at eps = 1e-7 and double
+/// (or x87 long double, all Eigen's matrix exponential takes) would leave 1e-9 (1e-12) of it.
+/// The inputs are the double numbers the schemes integrate. `accuracy` is the relative
+/// difference to a second evaluation with 8 times the scaling, or the rounding of u(t) to
+/// double where that is larger. Refuses (tsi::Error) n > max_affine_exact_dim, t < 0 and sizes
+/// that do not match.
+TSI_API ExactSolution::Value affine_exact_solution(const Matrix& A, double eps, const AffineTerms& f,
+                                                   const Vector& u0, double t);
+
+}  // namespace tsi
