@@ -93,6 +93,10 @@ const ParamSchema& output_schema() {
   static const ParamSchema schema = {
       integer_param("every", 1, "record the invariants, the tau monitors and a row of invariants.csv every this many steps (and at the last); other steps only check that the state is finite")
           .check([](const Json& v) { return v.get<long>() >= 1; }, "a positive integer"),
+      string_param("error_estimate", "none",
+                   "richardson: estimate the error of u(t_end) without a reference, from the same run at h / 2 "
+                   "and 2 h (2.5 times the run's cost more; t_end / h even): result.json's error_estimate")
+          .choices({"none", "richardson"}),
       number_param("checkpoint_seconds", 30.0,
                    "rewrite result.json (status running, the time reached) at most this often while a run goes")
           .range(0.0, 1e9, true, false),
@@ -256,13 +260,18 @@ Json resolve_run_config(const Json& raw, const Registry& registry) {
   Json out = resolve_selection(raw, registry);  // model, reformulation, scheme: the core's assembler
 
   out["time"] = resolve_params(time_schema(), section_object(raw, "time", empty), "time");
-  step_count(out);  // t_end must be a whole number of steps
+  const long steps = step_count(out);  // t_end must be a whole number of steps
 
   if (raw.contains("reference") && !raw.at("reference").is_null())
     out["reference"] = resolve_reference(raw, out["time"]["t_end"], registry);
 
   out["output"] = resolve_params(output_schema(), section_object(raw, "output", empty), "output");
   out["monitor"] = resolve_params(monitor_schema(), section_object(raw, "monitor", empty), "monitor");
+  if (out["output"]["error_estimate"] == "richardson" && steps % 2 != 0)
+    throw ConfigError("output.error_estimate",
+                      fmt::format("\"richardson\" reruns the run at h / 2 and 2 h: it needs an even number of steps "
+                                  "t_end / h, got {}",
+                                  steps));
 
   out["plugins"] = Json::array();
   if (raw.contains("plugins")) {

@@ -104,6 +104,12 @@ void check_run_steps(const Json& config, double max_steps) {
                                             "--max-steps = {:.3g}; choose a larger time.h or a smaller time.t_end, "
                                             "or raise the limit with --max-steps N",
                                             h, estimate, t_end, max_steps));
+  if (config.contains("output") && config["output"].value("error_estimate", std::string("none")) == "richardson" &&
+      !(2.0 * estimate <= max_steps))
+    throw ConfigError("output.error_estimate",
+                      fmt::format("\"richardson\" reruns the run at h / 2: {:.3g} steps, more than --max-steps = "
+                                  "{:.3g}; raise the limit with --max-steps N",
+                                  2.0 * estimate, max_steps));
 }
 
 void check_work_estimate(const Json& config, const Registry& registry, const RunSettings& settings) {
@@ -272,6 +278,78 @@ Json dense_output_entry(const DenseOutput& dense, const RunOutcome& outcome) {
   for (const Vector& u : dense.values())
     entry["u"].push_back(u.size() ? state_to_json(u, outcome.complex_state) : Json());
   return entry;
+}
+
+// u(t_end) in physical variables from the run's own configuration at `steps` steps (the same
+// model, data, scheme and re-preparation; the Richardson estimate's coarser runs). A state
+// that stops being finite, or an interrupt, is an error.
+Vector final_state_with_steps(const Json& config, const Registry& registry, const RunSettings& settings, long steps,
+                              const ProgressFn& progress, const char* what) {
+  AssemblyOptions options;
+  options.bind = false;
+  options.context = settings.context;
+  Assembly a = assemble(config, registry, options);
+  const double t_end = config["time"]["t_end"];
+  Vector y = a.reformulation->prepare(a.u0);
+  auto last_progress = Clock::now();
+  integrate(a.bind(t_end / static_cast<double>(steps)), y, steps, [&](long n, double t, const Vector& state) {
+    if (!state.allFinite()) throw Error(fmt::format("the state is not finite at t = {:.6g} (step {})", t, n));
+    if (interrupted()) throw Error(fmt::format("interrupted by signal {} at t = {:.6g}", interrupt_signal(), t));
+    if (progress && seconds_since(last_progress) > 0.5) {
+      progress(static_cast<double>(n) / static_cast<double>(steps), what);
+      last_progress = Clock::now();
+    }
+    return true;
+  });
+  return a.model->to_physical(a.reformulation->read_back(y, t_end));
+}
+
+// The Richardson estimate of the error of x = u_h(t_end) from u_{h/2} and u_{2h}: with
+// d = |u_h - u_{h/2}| and D = |u_2h - u_h| (relative to |x|), the observed order p = log2(D / d)
+// and the error d 2^p / (2^p - 1). The finer run measures the error at h itself (a step-size
+// resonance at h shows in it, which coarser runs would miss); the coarser one checks the
+// order: the run is in its asymptotic range where p lies between the scheme's uniform order
+// and its order at fixed eps (0.5 to spare each side); elsewhere the record says so, and p is
+// taken as the nearer of the two. A run that fails is recorded, not hidden.
+Json richardson_estimate(const Json& config, const Registry& registry, const RunSettings& settings,
+                         const StepperTraits& traits, const Model& model, const Vector& x, long steps,
+                         const ProgressFn& progress) {
+  const auto start = Clock::now();
+  const double h = config["time"]["h"];
+  Json out = {{"method", "richardson"}, {"h", {h / 2.0, h, 2.0 * h}}};
+  Vector fine, coarse;
+  try {  // whatever happens here, the run's own results are kept
+    fine = final_state_with_steps(config, registry, settings, 2 * steps, progress, "error estimate (h / 2)");
+    coarse = final_state_with_steps(config, registry, settings, steps / 2, progress, "error estimate (2 h)");
+  } catch (const std::exception& e) {
+    out["status"] = interrupted() ? "interrupted" : "failed";
+    out["message"] = fmt::format("a run at another step failed: {}", e.what());
+    out["relative"] = nullptr;
+    out["wall_seconds"] = seconds_since(start);
+    return out;
+  }
+  const double scale = model.error_norm(x);
+  const double d = model.error_norm(x - fine) / scale, D = model.error_norm(coarse - x) / scale;
+  const int low = std::max(1, traits.order), high = std::max(low, traits.classical_order);
+  const double observed = d > 0.0 && D > 0.0 ? std::log2(D / d) : std::numeric_limits<double>::quiet_NaN();
+  const bool asymptotic = std::isfinite(observed) && observed >= low - 0.5 && observed <= high + 0.5;
+  const double used = std::isfinite(observed) ? std::clamp(observed, static_cast<double>(low), static_cast<double>(high))
+                                              : static_cast<double>(low);
+  out["status"] = "completed";
+  out["differences"] = {d, D};
+  out["observed_order"] = std::isfinite(observed) ? Json(observed) : Json();
+  out["declared_orders"] = {low, high};
+  out["order_used"] = used;
+  out["relative"] = d * std::pow(2.0, used) / (std::pow(2.0, used) - 1.0);
+  out["asymptotic"] = asymptotic;
+  if (!asymptotic)
+    out["note"] = std::isfinite(observed)
+                      ? fmt::format("observed order {:.2f} from 2 h, h and h / 2, outside [{}, {}] (0.5 to spare): "
+                                    "not in the asymptotic range, the estimate is not reliable",
+                                    observed, low, high)
+                      : std::string("the runs at 2 h, h and h / 2 agree to the last digit: no order can be observed");
+  out["wall_seconds"] = seconds_since(start);
+  return out;
 }
 
 }  // namespace
@@ -517,6 +595,24 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
     outcome.reference_u_final = ref.x;
     error["reference"]["u_final"] = state_entry(ref.x, outcome.complex_state, outcome.state_shape, reference_u_final_file);
     result["error"] = error;
+  }
+  if (outcome.ok && config.contains("output") &&
+      config["output"].value("error_estimate", std::string("none")) == "richardson") {
+    result["error_estimate"] =
+        richardson_estimate(config, registry, settings, assembly.traits, *model, x, n_steps, progress);
+    if (result["error_estimate"]["status"] == "interrupted") {  // the run's results are kept, as for a reference
+      outcome.ok = false;
+      result["status"] = "interrupted";
+      outcome.message = fmt::format("interrupted while estimating the error: {} (the run itself completed: its "
+                                    "results are kept)",
+                                    result["error_estimate"]["message"].get<std::string>());
+      result["message"] = outcome.message;
+      return outcome;
+    }
+    if (result.contains("error") && result["error_estimate"]["relative"].is_number() &&
+        result["error"]["relative"].get<double>() > 0.0)
+      result["error_estimate"]["ratio_to_error"] =
+          result["error_estimate"]["relative"].get<double>() / result["error"]["relative"].get<double>();
   }
   return outcome;
 }

@@ -25,6 +25,7 @@ namespace {
 // The columns of table.csv, before the varied paths that are not among them.
 const std::vector<std::string> columns = {
     "id", "label", "model", "scheme", "reformulation", "eps", "h", "t_end", "n_tau", "error", "order",
+    "error_estimate", "estimate_ratio", "estimate_asymptotic",
     "err_H", "err_I", "err_m", "drift_H", "drift_I", "drift_m", "sweeps_mean", "rhs_evals",
     "wall_seconds", "t_reached", "status"};
 const std::set<std::string> covered = {"model.name", "scheme.name", "reformulation.name", "model.eps",
@@ -137,6 +138,9 @@ Json study_rows(const Study& study, const std::vector<RunOutcome>& outcomes) {
                 {"n_tau", c["reformulation"].value("n_tau", Json())},
                 {"error", number_or_null(r, "/error/relative"_json_pointer)},
                 {"order", nullptr},
+                {"error_estimate", number_or_null(r, "/error_estimate/relative"_json_pointer)},
+                {"estimate_ratio", number_or_null(r, "/error_estimate/ratio_to_error"_json_pointer)},
+                {"estimate_asymptotic", number_or_null(r, "/error_estimate/asymptotic"_json_pointer)},
                 {"err_H", number_or_null(r, "/invariants/H/max_rel_error"_json_pointer)},
                 {"err_I", number_or_null(r, "/invariants/I/max_rel_error"_json_pointer)},
                 {"err_m", number_or_null(r, "/invariants/m/max_rel_error"_json_pointer)},
@@ -326,6 +330,53 @@ void write_study_table(const std::string& dir, const Study& study, const Json& r
   write_file_atomically(dir + "/study.json", out.dump(2) + "\n");
 }
 
+// The Richardson estimates of a convergence table's runs against their true errors (where the
+// runs asked for one, output.error_estimate): estimate / error per eps and h, "*" where the
+// estimate's own check found the run outside its asymptotic range, and how many of the
+// asymptotic ones fall within 0.3x .. 3x.
+std::string estimate_table(const std::vector<const Json*>& members, const std::set<double, std::greater<>>& epss,
+                           const std::set<double, std::greater<>>& hs) {
+  std::map<std::pair<double, double>, const Json*> at;
+  bool any = false;
+  for (const Json* m : members) {
+    at[{(*m)["eps"].get<double>(), (*m)["h"].get<double>()}] = m;
+    any = any || !(*m)["estimate_asymptotic"].is_null();
+  }
+  if (!any) return "";
+  std::string s = "  Richardson estimate / true error (* : the estimate found the run pre-asymptotic; - : none)\n";
+  int asymptotic = 0, within = 0, pre = 0, missing = 0;
+  for (double h : hs) {
+    s += fmt::format("  {:>8}", fraction(h));
+    for (double e : epss) {
+      const auto it = at.find({e, h});
+      std::string c;
+      if (it != at.end()) {
+        const Json& r = *it->second;
+        if (r["estimate_ratio"].is_number()) {
+          const double ratio = r["estimate_ratio"].get<double>();
+          const bool ok = r["estimate_asymptotic"].is_boolean() && r["estimate_asymptotic"].get<bool>();
+          c = fmt::format("{:.2f}{}", ratio, ok ? "" : "*");
+          if (ok) {
+            ++asymptotic;
+            within += ratio >= 0.3 && ratio <= 3.0 ? 1 : 0;
+          } else {
+            ++pre;
+          }
+        } else {
+          c = "-";
+          ++missing;
+        }
+      }
+      s += fmt::format("{:>21}", c);
+    }
+    s += "\n";
+  }
+  s += fmt::format("  estimate within 0.3x .. 3x of the error: {} of {} asymptotic runs; {} pre-asymptotic (*); {} "
+                   "without an estimate or an error\n",
+                   within, asymptotic, pre, missing);
+  return s;
+}
+
 std::string study_text(const Study& study, const Json& rows) {
   std::string s = study.title.empty() ? "" : study.title + "\n";
   for (const auto& [path, ids] : study.not_used.items()) {
@@ -407,6 +458,7 @@ std::string study_text(const Study& study, const Json& rows) {
         s += fmt::format("{:>21}", c);
       }
       s += "\n";
+      s += estimate_table(members, epss, hs);
     }
   } else {
     const bool conservation = study.kind == "conservation";

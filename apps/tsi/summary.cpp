@@ -77,6 +77,16 @@ std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
                      r["error"]["relative"].get<double>(), r["error"]["reference"]["scheme"].get<std::string>(),
                      r["error"]["reference"]["reformulation"].get<std::string>(),
                      r["error"]["reference"]["tol"].get<double>());
+  if (r.contains("error_estimate")) {
+    const Json& e = r["error_estimate"];
+    if (e["relative"].is_number())
+      s += fmt::format("  estimated error (Richardson) {:.3e}   (observed order {} from 2 h, h, h / 2: {})\n",
+                       e["relative"].get<double>(),
+                       e["observed_order"].is_number() ? fmt::format("{:.2f}", e["observed_order"].get<double>()) : "-",
+                       e["asymptotic"].get<bool>() ? "asymptotic" : "NOT asymptotic, unreliable");
+    else
+      s += fmt::format("  estimated error (Richardson): none, {}\n", e.value("message", std::string("failed")));
+  }
   s += fmt::format("  written: {0}/result.json, {0}/invariants.csv", out_dir);
   if (outcome.u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, u_final_file);
   if (outcome.reference_u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, reference_u_final_file);
