@@ -119,6 +119,8 @@ class RunResult:
     times, u_times   output.times and u there (numpy, one row per time, NaN where the run did
                  not reach it); None without output.times
     error        the relative error against the reference (None without a reference)
+    error_estimate   the estimated relative error without a reference (output.error_estimate;
+                 None without one); result["error_estimate"] says how it was made
     reference    the reference's final state (numpy), reference_info its settings and cost
     invariants   invariants.csv by column: t, H, I, m, err_H, err_I, err_m, tau_roughness,
                  tau_spread and the model's own (numpy arrays; as in the file, the values carry
@@ -147,6 +149,8 @@ class RunResult:
         self.error = err.get("relative")
         self.error_absolute = err.get("absolute")
         self.reference_info = err.get("reference")
+        # The error estimate without a reference (output.error_estimate), None without one.
+        self.error_estimate = self.result.get("error_estimate", {}).get("relative")
         self.reference = native.get("reference_u_final")
         if self.reference is None and self.reference_info:
             self.reference = _state(self.reference_info.get("u_final"))
@@ -298,7 +302,7 @@ _solve_fields = itertools.count()
 
 
 def solve(A, f, eps, u0, t_span, *, scheme="eab", h=None, n_tau=32, times=None, time_dependent=True,
-          out=None, threads=None):
+          error_estimate=False, out=None, threads=None):
     """u' = (1/eps) A u + f(t, u) from u(t0) = u0 over t_span = (t0, t1), as HOODESolver.jl's
     solve: returns (t, u, result), t the times (the steps t0 + k h, or `times`), u the states
     there (numpy, one row per time) and result the RunResult (its error, invariants, cost).
@@ -311,13 +315,18 @@ def solve(A, f, eps, u0, t_span, *, scheme="eab", h=None, n_tau=32, times=None, 
     "order": 6}). h: the step (default (t1 - t0) / 100, as HOODESolver.jl; rounded to a whole
     number of steps). times: the times to return u at (any times in t_span: between the steps u
     comes from the two-scale solution interpolated in t). time_dependent=False when f does not
-    use t (one variable fewer).
+    use t (one variable fewer). error_estimate=True: the run also estimates its error without a
+    reference (Richardson's, from the same run at h / 2 and 2 h, as HOODESolver.jl's
+    getprecision; the number of steps is then made even): result.error_estimate, and the whole
+    record in result.result["error_estimate"].
     """
     t0, t1 = float(t_span[0]), float(t_span[1])
     if not t1 > t0:
         raise ValueError(f"t_span: got ({t0}, {t1}), expected t0 < t1")
     length = t1 - t0
     steps = max(1, int(round(length / (length / 100 if h is None else float(h)))))
+    if error_estimate and steps % 2:
+        steps += 1  # the estimate reruns at 2 h
     step = length / steps
     A = np.asarray(A)
     u0 = np.asarray(u0)
@@ -339,6 +348,8 @@ def solve(A, f, eps, u0, t_span, *, scheme="eab", h=None, n_tau=32, times=None, 
               "scheme": {"name": scheme} if isinstance(scheme, str) else dict(scheme),
               "time": {"h": step, "t_end": length},
               "output": {"times": [min(max(t - t0, 0.0), length) for t in wanted.tolist()]}}
+    if error_estimate:
+        config["output"]["error_estimate"] = "richardson"
     result = run(config, out=out, threads=threads)
     if not result.ok:
         raise RuntimeError(f"tsi.solve: the run {result.status}: {result.message}")

@@ -491,6 +491,30 @@ class SolveTests(unittest.TestCase):
         self.assertLess(errors[0], 1e-6)
         self.assertGreater(errors[0] / errors[1], 12.0)
 
+    def test_solve_estimates_its_error_without_a_reference(self):
+        # HOODESolver.jl's linear test through tsi.solve with an error estimate, against the
+        # exact solution of the same problem from the core's "linear" field (quad precision).
+        B = np.array([[0.12, -0.78, 0.91, 0.34], [-0.45, 0.56, 0.03, 0.54],
+                      [-0.67, 0.09, 0.18, 0.89], [-0.91, -0.56, 0.11, -0.56]])
+        a = np.array([0.12, -0.98, 0.45, 0.26])
+        b = np.array([-0.04, 0.48, 0.23, -0.87])
+        u0 = [-0.34, 0.78, 0.67, -5.6]
+
+        def f(t, u):
+            return B @ u + np.outer(a, t) + b[:, None]
+
+        t, u, r = tsi.solve(self.A, f, 1.5e-4, u0, (0.0, 1.0), h=1 / 16, error_estimate=True)
+        self.assertEqual(r.result["error_estimate"]["status"], "completed")
+        self.assertTrue(r.result["error_estimate"]["asymptotic"])
+        exact = tsi.run({"model": {"name": "matrix", "eps": 1.5e-4, "f": "linear"},
+                         "reformulation": {"name": "two-scale", "n_tau": 32},
+                         "scheme": {"name": "eab"}, "time": {"h": 1 / 16, "t_end": 1.0},
+                         "reference": {"scheme": "exact"}})
+        error = np.linalg.norm(u[-1] - exact.reference) / np.linalg.norm(exact.reference)
+        self.assertAlmostEqual(error / exact.error, 1.0, delta=1e-6)  # the same run, f in Python
+        self.assertGreater(r.error_estimate / error, 0.5)
+        self.assertLess(r.error_estimate / error, 2.0)
+
     def test_solve_refuses_an_empty_span(self):
         with self.assertRaises(ValueError):
             tsi.solve(self.A, lambda t, u: 0 * u, 1e-3, [0, 0, 0, 0], (1.0, 1.0))
