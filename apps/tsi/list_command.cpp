@@ -54,6 +54,7 @@ Json list_json(const Registry& registry, const std::string& what) {
       Json j = info_json(e->info);
       const StepperTraits t = default_traits(*e);  // with its default parameters
       j["traits"] = {{"order", t.order},         {"classical_order", std::max(t.order, t.classical_order)},
+                     {"resonant_order", t.order_with_resonances()},
                      {"symmetric", t.symmetric},
                      {"implicit", t.implicit},   {"multistep", t.multistep},
                      {"adaptive", t.adaptive},   {"initial_data_order", t.initial_data_order},
@@ -90,8 +91,13 @@ std::string list_text(const Registry& registry, const std::string& what) {
         std::string reforms;
         for (const auto& r : t["reformulations"]) reforms += (reforms.empty() ? "" : ", ") + r.get<std::string>();
         const int classical = t["classical_order"].get<int>();
-        s += fmt::format("      order {}{}, {}, {}, data order {}, on: {}\n", t["order"].get<int>(),
+        const int resonant = t["resonant_order"].get<int>();
+        s += fmt::format("      order {}{}{}, {}, {}, data order {}, on: {}\n", t["order"].get<int>(),
                          classical > t["order"].get<int>() ? fmt::format(" uniformly ({} at fixed eps)", classical) : "",
+                         resonant < t["order"].get<int>()
+                             ? (resonant > 0 ? fmt::format(", {} at step-size resonances h ~ k pi eps", resonant)
+                                             : std::string(", bounded only at step-size resonances h ~ k pi eps"))
+                             : "",
                          t["symmetric"].get<bool>() ? "symmetric" : "not symmetric",
                          t["implicit"].get<bool>() ? "implicit" : "explicit",
                          t["initial_data_order"].get<int>(), reforms);

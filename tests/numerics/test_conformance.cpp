@@ -143,8 +143,12 @@ TEST_CASE("conformance: every model with every two-scale scheme, in the model's 
   for (const auto* model : Harness::instance().registry().models()) {
     std::FILE* out = std::tmpfile();
     REQUIRE(out != nullptr);
+    // The model's declared eps only: the dense sample of the range (its rk78 references at
+    // eps = 1e-6 take seconds each) is tested through `tsi check` in tests/runner.
+    tsi::ModelCheckOptions options;
+    options.dense_eps_sample = false;
     const tsi::ModelCheckReport report =
-        tsi::check_model(Harness::instance().registry(), *model, two_scale_schemes(), {}, out);
+        tsi::check_model(Harness::instance().registry(), *model, two_scale_schemes(), options, out);
     std::rewind(out);
     std::string table;
     for (int c = std::fgetc(out); c != EOF; c = std::fgetc(out)) table += static_cast<char>(c);
@@ -154,18 +158,13 @@ TEST_CASE("conformance: every model with every two-scale scheme, in the model's 
     CHECK(report.failures.empty());
     CHECK(report.count > 0);
     for (const auto* scheme : two_scale_schemes()) {
-      const tsi::StepperTraits traits = tsi::default_traits(*scheme);
-      if (traits.classical_order > traits.order) {  // one row: the maximum over eps
-        const std::string row = fmt::format("ok    {:<12} {:<10}", scheme->info.name, "max");
-        CAPTURE(row);
-        CHECK(table.find(row) != std::string::npos);
-        continue;
-      }
-      for (const double eps : model->verification.epsilons) {
-        const std::string row = fmt::format("ok    {:<12} {:<10.4g}", scheme->info.name, eps);
-        CAPTURE(row);
-        CHECK(table.find(row) != std::string::npos);
-      }
+      // One verdict per scheme: the order of the maximum error over the model's eps, or that
+      // its errors there are all at the references' accuracy (the charged particle's at eps = 1
+      // for the high orders).
+      const std::string row = fmt::format("ok    {:<12} {:<10}", scheme->info.name, "max"),
+                        undecided = fmt::format("undec {:<12} {:<10}", scheme->info.name, "max");
+      CAPTURE(row);
+      CHECK((table.find(row) != std::string::npos || table.find(undecided) != std::string::npos));
     }
   }
 }

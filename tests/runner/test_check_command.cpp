@@ -2,7 +2,10 @@
 // a message that says what is wrong, on a model with a wrong linear flow.
 #include <doctest/doctest.h>
 
+#include <fmt/format.h>
+
 #include <string>
+#include <vector>
 
 #include "run_command.hpp"
 
@@ -123,7 +126,8 @@ TEST_CASE("check: --set reaches the schemes and the two-scale problem of every r
       t::run_tsi({"check", "henon-heiles", "--scheme", "eab", "--set", "scheme.order=2", "--eps", "1e-2"});
   INFO(second.describe());
   CHECK(second.exit_code == 0);
-  CHECK(t::contains(second.out, "2 +- 0.2"));
+  CHECK(t::contains(second.out, ">= 2 - 0.2"));
+  CHECK(t::contains(second.out, "ok    eab          max"));
   // Four tau points cannot resolve Henon-Heiles' tau dependence: the order is lost, and the
   // check measures why.
   const t::CommandResult coarse =
@@ -131,4 +135,35 @@ TEST_CASE("check: --set reaches the schemes and the two-scale problem of every r
   INFO(coarse.describe());
   CHECK(coarse.exit_code == 1);
   CHECK(t::contains(coarse.out, "the tau grid does not resolve the tau dependence"));
+}
+
+TEST_CASE("check: every shipped scheme passes on every shipped model, or is undecidable, for eps users type") {
+  // The eps lists a user is likely to type, 1e-2 .. 1e-4 (1e-6 takes minutes per model: the
+  // rk78 references cost 1/eps; measured by hand, docs/high-order.md). Every check passes or
+  // says why it cannot decide. One known defect is asserted as such: FD on Klein-Gordon at
+  // eps = 1e-2 stalls near 4.5e-6 from h = 1/128 to 1/512 (whatever n_tau and the data order
+  // at 1/128), so the order of its maximum falls short there.
+  const std::vector<std::vector<std::string>> lists = {
+      {"--eps", "1e-2"}, {"--eps", "1e-3"}, {"--eps", "1e-4"}, {"--eps", "1e-2", "--eps", "1e-3", "--eps", "1e-4"}};
+  for (const char* model : {"henon-heiles", "charged-particle", "klein-gordon", "matrix"}) {
+    for (const auto& list : lists) {
+      std::vector<std::string> command = {"check", model};
+      command.insert(command.end(), list.begin(), list.end());
+      const t::CommandResult r = t::run_tsi(command);
+      CAPTURE(model);
+      CAPTURE(fmt::format("{}", fmt::join(list, " ")));
+      INFO(r.describe());
+      const bool known = std::string(model) == "klein-gordon" && list[1] == "1e-2";
+      if (known) {
+        CHECK(r.exit_code == 1);
+        CHECK(t::contains(r.out, "1 of "));
+        CHECK(t::contains(r.out, "FAIL  fd           max"));
+        continue;
+      }
+      CHECK(r.exit_code == 0);
+      CHECK_FALSE(t::contains(r.out, "FAIL"));
+      // An undecidable check names its reason.
+      if (t::contains(r.out, "undec ")) CHECK(t::contains(r.out, "cannot decide"));
+    }
+  }
 }

@@ -18,12 +18,19 @@ struct TSI_API ModelCheckOptions {
   Json reformulation_params = Json::object();
   /// Scheme parameters, given to each checked scheme that takes them (tol, order, ...).
   Json scheme_params = Json::object();
+  /// Judge the uniform order on the maximum over a dense sample of the eps range (32
+  /// log-spaced, the given ones, the step-size resonances inside); false: over the given eps
+  /// only (cheaper: each eps costs an rk78 reference, 1/eps substeps).
+  bool dense_eps_sample = true;
 };
 
 /// What the checks of one model found.
 struct TSI_API ModelCheckReport {
   int count = 0;                      ///< checks run
   std::vector<std::string> failures;  ///< one line each, with the measured cause where one stands out
+  /// Checks that could not decide (too few errors above the references' accuracy), with why:
+  /// neither passed nor failed.
+  std::vector<std::string> undecidable;
   double seconds = 0.0;
 };
 

@@ -14,12 +14,20 @@ namespace tsi {
 /// What a scheme is and what it needs from the problem; declared at registration so the
 /// registry can refuse incompatible pairs before anything runs.
 struct TSI_API StepperTraits {
+  /// The order the maximum of the error over eps, step-size resonances included, falls at.
+  int order_with_resonances() const { return resonant_order >= 0 ? std::min(resonant_order, order) : order; }
   int order = 2;                         ///< order uniform in eps (on two-scale data)
   /// The order at a fixed eps as h -> 0 when it exceeds `order` (0: equal): a scheme whose
   /// error bound C h^order holds uniformly while at a given eps it falls faster or erratically
   /// below it (a composition, exponential collocation); its order is checked on the maximum
   /// of the errors over eps.
   int classical_order = 0;
+  /// The uniform order including step-size resonances h ~ k pi eps, when it is below `order`
+  /// (-1: equal; 0: bounded, no order): SE1 and SE2 reach `order` uniformly only under a
+  /// numerical non-resonance condition (the paper's, section 4); at h = k pi eps their error
+  /// falls at order 1 (docs/high-order.md). `tsi check` judges the maximum over eps,
+  /// resonances included, by it.
+  int resonant_order = -1;
   bool symmetric = false;                ///< step(h) then step(-h) returns the start
   bool implicit = false;                 ///< has implicit stages (fixed-point iteration)
   bool multistep = false;                ///< needs a start-up; reset() starts a new trajectory
