@@ -55,8 +55,10 @@ class Eab final : public tsi::Stepper {
       scaled_weights(lambda, h, weights_of, kappa, weights_[k]);
     }
     history_.assign(r_, problem.new_state());
-    past_.assign(r_ - 1, problem.new_state());
-    if (startup_ == Startup::hoodesolver && r_ > 1) prepare_stages(lambda, h);
+    if (startup_ == Startup::hoodesolver && r_ > 1)
+      prepare_stages(lambda, h);
+    else
+      past_.assign(r_ - 1, problem.new_state());  // the interpolatory start-up's values only
   }
 
   void reset() override {
@@ -85,14 +87,16 @@ class Eab final : public tsi::Stepper {
   }
 
   double state_vectors() const override { return state_vectors_for(problem_.layout(), {r_, startup_}); }
-  // (r + 1) r coefficients; the history of r values of N and the start-up's r - 1 past values;
-  // HOODESolver's start-up: 2 (r - 1) more (the backward values' N, the forward values), and
-  // its stages' coefficients, sum over q of q + (q - 1) and two exponentials.
+  // (r + 1) r coefficients (the weights and exponentials of the step and of the values at
+  // -k h); the history of r values of N, and the interpolatory start-up's r - 1 past values or
+  // HOODESolver's 3 (r - 1) (its backward values, their N, its forward values) with its stages'
+  // coefficients: e^{-hL}, q - 1 backward weights for q = 2 .. r and q forward ones for
+  // q = 2 .. r - 1, r (r - 1) in all.
   static double state_vectors_for(const tsi::ProblemLayout& layout, const Settings& settings) {
     const int r = settings.order;
     double vectors = (r + 1.0) * r * layout.diagonal_fraction() + 2.0 * r - 1.0;
     if (settings.startup == Startup::hoodesolver && r > 1)
-      vectors += 2.0 * (r - 1) + (static_cast<double>(r) * r + 1.0) * layout.diagonal_fraction();
+      vectors += 2.0 * (r - 1) + static_cast<double>(r) * (r - 1) * layout.diagonal_fraction();
     return vectors;
   }
 
