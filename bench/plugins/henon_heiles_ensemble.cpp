@@ -16,9 +16,12 @@ using tsi::Index;
 using tsi::MatrixRef;
 using tsi::Vector;
 
-class HenonHeilesEnsemble final : public tsi::Model {
+class HenonHeilesEnsemble final : public tsi::Model, public tsi::HamiltonianStructure, public tsi::FusedTauGrid {
  public:
   HenonHeilesEnsemble(double eps, Index copies) : Model(eps), copies_(copies) {}
+
+  const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
+  const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
 
   Index dim() const override { return 4 * copies_; }
   bool is_complex() const override { return false; }

@@ -149,7 +149,7 @@ Matrix PeriodicMatrixFlow::at(double tau) const {
 
 namespace {
 
-class MatrixModel final : public Model {
+class MatrixModel final : public Model, public FusedTauGrid, public PhysicalVariables {
  public:
   MatrixModel(double eps, PeriodicMatrixFlow flow, std::shared_ptr<const Field> field, bool time_dependent,
               bool is_complex, Vector u0, std::string field_name)
@@ -170,7 +170,9 @@ class MatrixModel final : public Model {
   Index dim() const override { return d_ + (time_ ? 1 : 0); }
   Index physical_dim() const override { return d_; }
   bool is_complex() const override { return complex_; }
-  bool has_hamiltonian_structure() const override { return false; }
+  // No Hamiltonian structure: f is any field, A any matrix with a 2 pi-periodic e^{A tau}.
+  const FusedTauGrid* fused_tau_grid() const override { return this; }
+  const PhysicalVariables* physical_variables() const override { return this; }
   double max_linear_frequency() const override { return std::max(1.0, static_cast<double>(flow_.max_frequency())); }
 
   void linear_flow(const RealVector& taus, MatrixRef states) const override {

@@ -37,6 +37,7 @@ void Model::nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef dir
 }
 
 void Model::filtered_field(const RealVector& taus, MatrixRef states, MatrixRef out) const {
+  if (const FusedTauGrid* fused = fused_tau_grid()) return fused->filtered_field(taus, states, out);
   linear_flow(taus, states);
   nonlinear_field(states, out);
   const RealVector minus_taus = -taus;
@@ -47,9 +48,14 @@ void TauGridField::evaluate_real(RealMatrixRef, RealMatrixRef) {
   throw Error("this tau-grid binding does not evaluate real grids (evaluates_real() is false)");
 }
 
+void FusedTauGrid::filtered_field(const RealVector& taus, MatrixRef states, MatrixRef out) const {
+  bind_tau_grid(taus)->evaluate(states, out);
+}
+
 namespace {
 
-// The default binding: the model's filtered_field with the stored phases.
+// The binding of a model without the fused capability: flow, field and flow back with the
+// stored phases.
 class StoredPhasesField final : public TauGridField {
  public:
   StoredPhasesField(const Model& model, RealVector taus) : model_(model), taus_(std::move(taus)) {}
@@ -60,10 +66,36 @@ class StoredPhasesField final : public TauGridField {
   RealVector taus_;
 };
 
+// The same with the fused capability's filtered_field.
+class StoredPhasesFusedField final : public TauGridField {
+ public:
+  StoredPhasesFusedField(const FusedTauGrid& fused, RealVector taus) : fused_(fused), taus_(std::move(taus)) {}
+  void evaluate(MatrixRef states, MatrixRef out) override { fused_.filtered_field(taus_, states, out); }
+
+ private:
+  const FusedTauGrid& fused_;
+  RealVector taus_;
+};
+
+[[noreturn]] void no_hamiltonian(const char* what) {
+  throw Error(std::string("this model declares no Hamiltonian structure (Model::hamiltonian() is null): it has no ") +
+              what);
+}
+
 }  // namespace
 
+std::unique_ptr<TauGridField> bind_filtered_field(const FusedTauGrid& fused, const RealVector& taus) {
+  return std::make_unique<StoredPhasesFusedField>(fused, taus);
+}
+
 std::unique_ptr<TauGridField> Model::bind_tau_grid(const RealVector& taus) const {
+  if (const FusedTauGrid* fused = fused_tau_grid()) return fused->bind_tau_grid(taus);
   return std::make_unique<StoredPhasesField>(*this, taus);
+}
+
+bool Model::independent_tau_grid_bindings() const {
+  const FusedTauGrid* fused = fused_tau_grid();
+  return fused && fused->independent_tau_grid_bindings();
 }
 
 const RealVector& Model::linear_remainder() const {
@@ -80,41 +112,64 @@ void Model::remainder_flow(double t, Vector& u) const {
 double Model::remainder_energy(const Vector& u) const {
   const RealVector& omega = linear_remainder();
   if (omega.size() == 0) return 0.0;
-  // R u = -J (i omega . u), since J^{-1} = -J for a symplectic J.
+  const HamiltonianStructure* h = hamiltonian();
+  if (!h) no_hamiltonian("energy of the remainder");
+  // R' u = -J (i omega . u), since J^{-1} = -J for a symplectic J.
   const Vector i_omega_u = (Complex(0.0, 1.0) * omega.cast<Complex>()).cwiseProduct(u);
   Vector r(u.size());
-  apply_J(i_omega_u, r);
+  h->apply_J(i_omega_u, r);
   return -0.5 * inner(r, u);
 }
 
-namespace {
-[[noreturn]] void no_hamiltonian(const char* what) {
-  throw Error(std::string("this model declares no Hamiltonian structure (has_hamiltonian_structure() is false): it "
-                          "has no ") + what);
-}
-}  // namespace
-
 void Model::apply_A(const Vector& u, Vector& out) const {
+  const HamiltonianStructure* h = hamiltonian();
+  if (!h) no_hamiltonian("J M: a model of the general class overrides apply_A");
   Vector mu(u.size());
-  apply_M(u, mu);
-  apply_J(mu, out);
+  h->apply_M(u, mu);
+  h->apply_J(mu, out);
 }
 
-void Model::apply_M(const Vector&, Vector&) const { no_hamiltonian("M"); }
-void Model::apply_J(const Vector&, Vector&) const { no_hamiltonian("J"); }
-double Model::H1(const Vector&) const { no_hamiltonian("H1"); }
-
-void Model::nonlinear_flow(double /*t*/, Vector& /*u*/) const {
-  throw Error("this model has no exact nonlinear flow (has_exact_nonlinear_flow() is false)");
+void Model::nonlinear_flow(double t, Vector& u) const {
+  const ExactNonlinearFlow* flow = exact_nonlinear_flow();
+  if (!flow) throw Error("this model has no exact nonlinear flow (Model::exact_nonlinear_flow() is null)");
+  flow->nonlinear_flow(t, u);
 }
 
 double Model::oscillatory_energy(const Vector& u) const {
+  const HamiltonianStructure* h = hamiltonian();
+  if (!h) no_hamiltonian("oscillatory energy");
   Vector mu(u.size());
-  apply_M(u, mu);
+  h->apply_M(u, mu);
   return inner(mu, u) / (2.0 * eps_);
 }
 
 double Model::mass(const Vector& u) const { return inner(u, u); }
+
+double Model::energy(const Vector& u) const {
+  const HamiltonianStructure* h = hamiltonian();
+  if (!h) no_hamiltonian("energy");
+  return oscillatory_energy(u) + remainder_energy(u) + h->H1(u);
+}
+
+Index Model::physical_dim() const {
+  const PhysicalVariables* p = physical_variables();
+  return p ? p->physical_dim() : dim();
+}
+
+Vector Model::from_physical(const Vector& x) const {
+  const PhysicalVariables* p = physical_variables();
+  return p ? p->from_physical(x) : x;
+}
+
+Vector Model::to_physical(const Vector& u) const {
+  const PhysicalVariables* p = physical_variables();
+  return p ? p->to_physical(u) : u;
+}
+
+double Model::error_norm(const Vector& x) const {
+  const PhysicalVariables* p = physical_variables();
+  return p ? p->error_norm(x) : x.norm();
+}
 
 Vector Model::linear_flow(double tau, const Vector& u) const {
   Matrix states = u;

@@ -224,7 +224,8 @@ void ModelChecks::interface(double eps) {
         relative(mod.linear_flow(0.7, mod.linear_flow(1.9, w)), mod.linear_flow(2.6, w), w_norm), 1e-10,
         "linear_flow must be the exact flow of a linear equation (a one-parameter group)");
 
-  const bool hamiltonian = mod.has_hamiltonian_structure();
+  const HamiltonianStructure* structure = mod.hamiltonian();
+  const bool hamiltonian = structure != nullptr;
   if (!hamiltonian)
     fmt::print(out_, "    {:<5} {}\n", "note",
                "the model declares no Hamiltonian structure: the checks of J, M, H1 and of energy conservation are "
@@ -232,8 +233,8 @@ void ModelChecks::interface(double eps) {
   Vector au(n);
   if (hamiltonian) {
     Vector mw(n);
-    mod.apply_M(w, mw);
-    mod.apply_J(mw, au);
+    structure->apply_M(w, mw);
+    structure->apply_J(mw, au);
   } else {
     mod.apply_A(w, au);
   }

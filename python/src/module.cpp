@@ -119,7 +119,7 @@ auto call_python(const std::string& model, const char* method, F&& f) {
   }
 }
 
-class PythonModel final : public tsi::Model {
+class PythonModel final : public tsi::Model, public tsi::HamiltonianStructure, public tsi::FusedTauGrid {
  public:
   PythonModel(double eps, py::object instance, std::string name)
       : Model(eps), name_(std::move(name)), self_(instance.release().ptr()) {
@@ -143,7 +143,10 @@ class PythonModel final : public tsi::Model {
 
   tsi::Index dim() const override { return dim_; }
   bool is_complex() const override { return complex_; }
-  bool has_hamiltonian_structure() const override { return hamiltonian_; }
+  // `hamiltonian = False` declares no Hamiltonian structure; the fused capability is the
+  // binding of the run's tau grid as one numpy array (filtered_field if the class has it).
+  const tsi::HamiltonianStructure* hamiltonian() const override { return hamiltonian_ ? this : nullptr; }
+  const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
   double max_linear_frequency() const override { return max_frequency_; }
 
   void linear_flow(const tsi::RealVector& taus, tsi::MatrixRef states) const override {
@@ -159,7 +162,7 @@ class PythonModel final : public tsi::Model {
   }
 
   void filtered_field(const tsi::RealVector& taus, tsi::MatrixRef states, tsi::MatrixRef out) const override {
-    if (!has_filtered_) return Model::filtered_field(taus, states, out);
+    if (!has_filtered_) return three_passes(taus, states, out);
     call_python(name_, "filtered_field", [&] {
       store(out, self().attr("filtered_field")(taus, batch(states)), "filtered_field");
     });
@@ -179,7 +182,7 @@ class PythonModel final : public tsi::Model {
       }
     }
     void evaluate(tsi::MatrixRef states, tsi::MatrixRef out) override {
-      if (!model_.has_filtered_) return model_.Model::filtered_field(taus_, states, out);
+      if (!model_.has_filtered_) return model_.three_passes(taus_, states, out);
       call_python(model_.name_, "filtered_field", [&] {
         model_.store(out, model_.self().attr("filtered_field")(py::handle(array_), model_.batch(states)),
                      "filtered_field");
@@ -225,6 +228,14 @@ class PythonModel final : public tsi::Model {
 
  private:
   py::handle self() const { return py::handle(self_); }
+
+  // f_tau of a class without filtered_field: flow, field, flow back.
+  void three_passes(const tsi::RealVector& taus, tsi::MatrixRef states, tsi::MatrixRef out) const {
+    linear_flow(taus, states);
+    nonlinear_field(states, out);
+    const tsi::RealVector minus_taus = -taus;
+    linear_flow(minus_taus, out);
+  }
 
   // States as numpy arrays, one column per state: float64 for a real model (the real parts),
   // complex128 otherwise.

@@ -139,7 +139,7 @@ TEST_CASE("cpd: e^{JM tau} solves d/dtau = JM, is 2 pi periodic and keeps <Mu, u
   auto model = h.model("cpd", 0.3);
   Vector u(4), mu(4), jmu(4);
   u << 0.8, -0.9, 1.3, 0.2;
-  model->apply_M(u, mu);
+  model->hamiltonian()->apply_M(u, mu);
   const double mu_u = tsi::inner(mu, u);
   for (double tau : {0.0, 0.4, 1.0, 2.5, 4.0, 6.0}) {
     CAPTURE(tau);
@@ -149,13 +149,13 @@ TEST_CASE("cpd: e^{JM tau} solves d/dtau = JM, is 2 pi periodic and keeps <Mu, u
     const Vector derivative = (8.0 * (model->linear_flow(tau + d, u) - model->linear_flow(tau - d, u)) -
                                (model->linear_flow(tau + 2 * d, u) - model->linear_flow(tau - 2 * d, u))) /
                               (12.0 * d);
-    model->apply_M(flowed, mu);
-    model->apply_J(mu, jmu);
+    model->hamiltonian()->apply_M(flowed, mu);
+    model->hamiltonian()->apply_J(mu, jmu);
     CHECK(relative(derivative, jmu) < 1e-11);
     // Period 2 pi, a group, and <Mu, u> is kept (JM is skew with respect to M).
     CHECK(relative(model->linear_flow(tau + tsi::two_pi, u), flowed) < 1e-15);
     CHECK(relative(model->linear_flow(0.7, flowed), model->linear_flow(tau + 0.7, u)) < 1e-15);
-    model->apply_M(flowed, mu);
+    model->hamiltonian()->apply_M(flowed, mu);
     CHECK(tsi::inner(mu, flowed) == doctest::Approx(mu_u).epsilon(1e-14).scale(0.0));
   }
   // 2 pi is the period, not a multiple of a shorter one: JM has eigenvalues +-i.

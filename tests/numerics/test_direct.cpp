@@ -25,9 +25,11 @@ Vector rk78_direct(const std::string& model_name, double eps, const std::string&
 }
 
 // x = u + 1: affine, so T F(T^{-1} x) is not the field in x.
-class ShiftedPhysical final : public tsi::fixture::HarmonicModel {
+class ShiftedPhysical final : public tsi::fixture::HarmonicModel, public tsi::PhysicalVariables {
  public:
   using HarmonicModel::HarmonicModel;
+  const tsi::PhysicalVariables* physical_variables() const override { return this; }
+  tsi::Index physical_dim() const override { return 2; }
   Vector to_physical(const Vector& u) const override { return u.array() + 1.0; }
   Vector from_physical(const Vector& x) const override { return x.array() - 1.0; }
 };

@@ -26,9 +26,11 @@ struct ThreadSetting : tsi::test::ContextSetting {
 // u' = J[(1/eps) M u + grad H1] with a linear grad H1 (so any answer is easy to predict), whose
 // bindings throw on the columns that do not hold tau = 0: on a split grid, a thread other than
 // the first fails.
-class ThrowingModel final : public tsi::Model {
+class ThrowingModel final : public tsi::Model, public tsi::HamiltonianStructure, public tsi::FusedTauGrid {
  public:
   explicit ThrowingModel(bool independent) : Model(0.1), independent_(independent) {}
+  const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
+  const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
   Index dim() const override { return 64; }
   bool is_complex() const override { return true; }
   void linear_flow(const tsi::RealVector&, tsi::MatrixRef) const override {}

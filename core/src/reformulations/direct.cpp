@@ -61,9 +61,9 @@ void Direct::model_nonlinear(const Vector& u, Vector& out) {
 
 void Direct::model_rhs(const Vector& u, Vector& out) {
   model_nonlinear(u, out);
-  if (model_->has_hamiltonian_structure()) {  // J M u through the run's buffers (apply_A's default allocates)
-    model_->apply_M(u, mu_);
-    model_->apply_J(mu_, au_);
+  if (const HamiltonianStructure* h = model_->hamiltonian()) {  // J M u through the run's buffers (apply_A's default allocates)
+    h->apply_M(u, mu_);
+    h->apply_J(mu_, au_);
   } else {
     model_->apply_A(u, au_);
   }

@@ -35,9 +35,13 @@ using tsi::Index;
 using tsi::MatrixRef;
 using tsi::Vector;
 
-class Fput final : public tsi::Model {
+// Hamiltonian (energies are reported), with its own physical variables.
+class Fput final : public tsi::Model, public tsi::HamiltonianStructure, public tsi::PhysicalVariables {
  public:
   Fput(double eps, Index m) : Model(eps), m_(m), root_eps_(std::sqrt(eps)) {}
+
+  const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
+  const tsi::PhysicalVariables* physical_variables() const override { return this; }
 
   Index dim() const override { return 4 * m_; }
   bool is_complex() const override { return false; }
@@ -104,6 +108,8 @@ class Fput final : public tsi::Model {
     x(3 * m_) = 1.0;  // y1_1
     return from_physical(x);
   }
+
+  Index physical_dim() const override { return dim(); }
 
   // (x0, x1, y0, y1) <-> (x0, xi, y0, eta) = (x0, x1 / sqrt(eps), y0, sqrt(eps) y1).
   Vector from_physical(const Vector& x) const override {

@@ -30,11 +30,20 @@ using tsi::Vector;
 
 enum class Potential { Coulomb, Harmonic };
 
-class ChargedParticle final : public tsi::Model {
+class ChargedParticle final : public tsi::Model,
+                              public tsi::HamiltonianStructure,
+                              public tsi::FusedTauGrid,
+                              public tsi::ExactNonlinearFlow,
+                              public tsi::PhysicalVariables {
  public:
   ChargedParticle(double eps, Potential potential) : Model(eps), potential_(potential) {}
   using Model::linear_flow;
   using Model::nonlinear_field;
+
+  const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
+  const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
+  const tsi::ExactNonlinearFlow* exact_nonlinear_flow() const override { return this; }
+  const tsi::PhysicalVariables* physical_variables() const override { return this; }
 
   Index dim() const override { return 4; }
   bool is_complex() const override { return false; }
@@ -177,8 +186,6 @@ class ChargedParticle final : public tsi::Model {
 
   double H1(const Vector& u) const override { return 2.0 * eps() * potential(u(0).real(), u(1).real()); }
 
-  bool has_exact_nonlinear_flow() const override { return true; }
-
   // q' = 0, p' = -2 eps grad U(q): q fixed, p moves linearly in t.
   void nonlinear_flow(double t, Vector& u) const override {
     Vector field = nonlinear_field(u);
@@ -218,6 +225,8 @@ class ChargedParticle final : public tsi::Model {
     x << 0.8, 0.9, 0.5, 0.6;
     return from_physical(x);
   }
+
+  Index physical_dim() const override { return 4; }
 
   // (x, v) -> (q, p) = (x, 2 eps v - B x).
   Vector from_physical(const Vector& x) const override {

@@ -15,9 +15,12 @@ using tsi::Index;
 using tsi::MatrixRef;
 using tsi::Vector;
 
-class HenonHeiles final : public tsi::Model {
+class HenonHeiles final : public tsi::Model, public tsi::HamiltonianStructure, public tsi::FusedTauGrid {
  public:
   explicit HenonHeiles(double eps) : Model(eps) {}
+
+  const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
+  const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
 
   Index dim() const override { return 4; }
   bool is_complex() const override { return false; }

@@ -70,7 +70,11 @@ struct Phases {
   tsi::RealVector cos, sin;
 };
 
-class KleinGordon final : public tsi::Model {
+class KleinGordon final : public tsi::Model,
+                          public tsi::HamiltonianStructure,
+                          public tsi::FusedTauGrid,
+                          public tsi::ExactNonlinearFlow,
+                          public tsi::PhysicalVariables {
  public:
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
   KleinGordon(double eps, int n_x, double lambda, tsi::ThreadLimit fftw_threads = {})
@@ -88,6 +92,11 @@ class KleinGordon final : public tsi::Model {
 
   Index dim() const override { return n_x_; }
   bool is_complex() const override { return true; }
+
+  const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
+  const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
+  const tsi::ExactNonlinearFlow* exact_nonlinear_flow() const override { return this; }
+  const tsi::PhysicalVariables* physical_variables() const override { return this; }
 
   // e^{JM tau} = e^{i tau}: one phase for every coordinate.
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
@@ -195,8 +204,6 @@ class KleinGordon final : public tsi::Model {
 
   const tsi::RealVector& linear_remainder() const override { return remainder_; }
 
-  bool has_exact_nonlinear_flow() const override { return true; }
-
   // z is constant along u' = J grad H1 (the field only moves p), so the field is too.
   void nonlinear_flow(double t, Vector& c) const override {
     const Vector field = nonlinear_field(c);
@@ -212,6 +219,8 @@ class KleinGordon final : public tsi::Model {
     }
     return from_physical(v);
   }
+
+  Index physical_dim() const override { return n_x_; }
 
   // Grid samples of v -> c = sqrt(2 pi) / n_x * a forward(v).
   Vector from_physical(const Vector& v) const override {

@@ -37,7 +37,11 @@ using tsi::MatrixRef;
 using tsi::Vector;
 
 
-class Nls final : public tsi::Model {
+class Nls final : public tsi::Model,
+                  public tsi::HamiltonianStructure,
+                  public tsi::FusedTauGrid,
+                  public tsi::ExactNonlinearFlow,
+                  public tsi::PhysicalVariables {
  public:
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
   Nls(double eps, int n_x, tsi::ThreadLimit fftw_threads = {})
@@ -48,6 +52,11 @@ class Nls final : public tsi::Model {
 
   Index dim() const override { return n_x_; }
   bool is_complex() const override { return true; }
+
+  const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
+  const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
+  const tsi::ExactNonlinearFlow* exact_nonlinear_flow() const override { return this; }
+  const tsi::PhysicalVariables* physical_variables() const override { return this; }
 
   // e^{JM tau}: mode m times e^{-i m^2 tau}.
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
@@ -239,8 +248,6 @@ class Nls final : public tsi::Model {
   // The fastest mode, m = N_x/2, turns with e^{-i (N_x/2)^2 tau}.
   double max_linear_frequency() const override { return 0.25 * n_x_ * n_x_; }
 
-  bool has_exact_nonlinear_flow() const override { return true; }
-
   // u' = -i |u|^2 u keeps |u| fixed pointwise: u -> u e^{-i |u|^2 t} on the grid.
   void nonlinear_flow(double t, Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -263,6 +270,8 @@ class Nls final : public tsi::Model {
     }
     return from_physical(x);
   }
+
+  Index physical_dim() const override { return n_x_; }
 
   // Grid samples -> c = sqrt(2 pi) / N_x * forward(samples).
   Vector from_physical(const Vector& x) const override {

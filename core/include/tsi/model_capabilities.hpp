@@ -1,0 +1,123 @@
+#pragma once
+// What a model may declare beyond the required core of tsi::Model (model.hpp). Each is an
+// interface a model implements (usually by inheriting it) and hands out from its getter on
+// Model (hamiltonian(), fused_tau_grid(), exact_nonlinear_flow(), physical_variables(),
+// exact_solution()); a null getter means the model does not have it, and the parts of tsi
+// that need it say so (a splitting scheme needs the exact nonlinear flow, energies need the
+// Hamiltonian structure, `tsi check` skips what a model does not declare).
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "tsi/export.hpp"
+#include "tsi/types.hpp"
+
+namespace tsi {
+
+/// f_tau over one fixed set of phases (a run's tau grid), bound once per run by
+/// FusedTauGrid::bind_tau_grid: what the model precomputes for those phases (rotation tables,
+/// phase factors, transform buffers) lives here, so an evaluation neither receives the phases
+/// again nor has to recognise them.
+class TSI_API TauGridField {
+ public:
+  virtual ~TauGridField() = default;
+  /// out.col(j) = f_{tau_j}(states.col(j)) for the bound phases tau_j. `states` is scratch:
+  /// it may be left overwritten.
+  virtual void evaluate(MatrixRef states, MatrixRef out) = 0;
+  /// True when the binding also evaluates real grids (evaluate_real): a real model's
+  /// two-scale problem keeps its tau grid real (half the memory and work of a complex one).
+  /// False by default: the reformulation then copies the real grid through complex buffers.
+  virtual bool evaluates_real() const { return false; }
+  /// evaluate on real grid values (real models that declare evaluates_real; the default throws).
+  virtual void evaluate_real(RealMatrixRef states, RealMatrixRef out);
+  /// True when evaluate(states, out) (and evaluate_real) may be called with out and states the
+  /// same matrix (each column read before it is written): the two-scale problem then evaluates
+  /// in the caller's vector and holds no grid buffer of its own.
+  virtual bool in_place() const { return false; }
+};
+
+/// The filtered field f_tau(u) = e^{-A tau} f(e^{A tau} u) in one pass instead of the three
+/// (flow, field, flow back) a model without it gets: the two-scale reformulation's hot path.
+/// `tsi check` compares both routes with the definition.
+class TSI_API FusedTauGrid {
+ public:
+  virtual ~FusedTauGrid() = default;
+  /// f_tau on a run's fixed tau grid, bound once (tables precomputed for those phases).
+  virtual std::unique_ptr<TauGridField> bind_tau_grid(const RealVector& taus) const = 0;
+  /// f_tau for column j at taus[j], phases given per call (the filtered problem, whose phase
+  /// moves with t). The default binds the phases and evaluates once.
+  virtual void filtered_field(const RealVector& taus, MatrixRef states, MatrixRef out) const;
+  /// True when every binding owns its work space, so that bindings of disjoint ranges of one
+  /// tau grid may evaluate at the same time on different threads (tsi --threads). False by
+  /// default: a model whose field shares state (a buffer, a lock, an interpreter) runs on one
+  /// thread.
+  virtual bool independent_tau_grid_bindings() const { return false; }
+};
+
+/// A binding that calls fused.filtered_field with the stored phases: bind_tau_grid for a model
+/// whose fused field takes its phases per call and precomputes nothing.
+TSI_API std::unique_ptr<TauGridField> bind_filtered_field(const FusedTauGrid& fused, const RealVector& taus);
+
+/// The Hamiltonian structure of the paper's class (eq. model): A = J M and f = J grad H1, so
+///     u' = J [ (1/eps) M u + R u + grad H1(u) ],
+/// J symplectic, M self-adjoint, JM = MJ. Where a model declares it, runs report the energy
+/// H, the oscillatory energy I and the mass m, and `tsi check` tests the structure.
+class TSI_API HamiltonianStructure {
+ public:
+  virtual ~HamiltonianStructure() = default;
+  /// out = M u.
+  virtual void apply_M(const Vector& u, Vector& out) const = 0;
+  /// out = J u.
+  virtual void apply_J(const Vector& u, Vector& out) const = 0;
+  /// The non-stiff part H1 of the Hamiltonian.
+  virtual double H1(const Vector& u) const = 0;
+};
+
+/// The exact flow of u' = f(u) alone (splitting schemes and the direct problem's exact
+/// sub-flows need it).
+class TSI_API ExactNonlinearFlow {
+ public:
+  virtual ~ExactNonlinearFlow() = default;
+  /// u <- the exact flow of u' = f(u) over time t.
+  virtual void nonlinear_flow(double t, Vector& u) const = 0;
+};
+
+/// Physical variables different from the model's own (an initial value in a config, u_final,
+/// errors and their norm): without it they are the model's variables, errors in the Euclidean
+/// norm.
+class TSI_API PhysicalVariables {
+ public:
+  virtual ~PhysicalVariables() = default;
+  /// Entries of a physical state (a model that carries more, as the matrix model with a
+  /// time-dependent f carries t, returns fewer than dim()).
+  virtual Index physical_dim() const = 0;
+  /// Model variables from a physical state.
+  virtual Vector from_physical(const Vector& x) const = 0;
+  /// The physical state of model variables u.
+  virtual Vector to_physical(const Vector& u) const = 0;
+  /// The norm relative errors are measured in, on physical states (Euclidean by default).
+  virtual double error_norm(const Vector& x) const { return x.norm(); }
+};
+
+/// A quantity a model declares as conserved (or nearly) besides H, I and m: runs record its
+/// relative change and plot it (NLS: the momentum; charged particle: the magnetic moment).
+struct TSI_API ModelInvariant {
+  std::string name;         ///< a column name: letters, digits and '_' ("P", "mu")
+  std::string description;  ///< one line, for the run's files and plots
+  std::function<double(const Vector& u)> value;  ///< of a state in model variables
+};
+
+/// An exact solution of a model's equation, where the model knows one (the matrix model with
+/// an affine field): a reference without discretisation error (a run's reference.scheme "exact").
+class TSI_API ExactSolution {
+ public:
+  virtual ~ExactSolution() = default;
+  struct Value {
+    Vector x;         ///< u(t), physical variables
+    double accuracy;  ///< its estimated relative error (at least the rounding of x to double)
+  };
+  /// u(t) from u(0) = x0, both in physical variables, for t >= 0.
+  virtual Value at(const Vector& x0, double t) const = 0;
+};
+
+}  // namespace tsi
