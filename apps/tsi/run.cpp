@@ -150,6 +150,25 @@ void check_reference_cost(const Json& config, const Registry& registry, const Ru
 
 namespace {
 
+// u(t_end) in model variables from an assembly's initial value in `steps` equal steps, with
+// progress under the name `what`. An interrupt, or a state that stops being finite, is an
+// error (a run's own integration records these instead; this serves the side runs: the
+// reference and the error estimate's).
+Vector final_model_state(Assembly& a, double t_end, long steps, const ProgressFn& progress, const char* what) {
+  Vector y = a.reformulation->prepare(a.u0);
+  auto last_progress = Clock::now();
+  integrate(a.bind(t_end / static_cast<double>(steps)), y, steps, [&](long n, double t, const Vector& state) {
+    if (!state.allFinite()) throw Error(fmt::format("{}: the state is not finite at t = {:.6g} (step {})", what, t, n));
+    if (interrupted()) throw Error(fmt::format("interrupted by signal {} at t = {:.6g}", interrupt_signal(), t));
+    if (progress && seconds_since(last_progress) > 0.5) {
+      progress(static_cast<double>(n) / static_cast<double>(steps), what);
+      last_progress = Clock::now();
+    }
+    return true;
+  });
+  return a.reformulation->read_back(y, t_end);
+}
+
 // The reference's final state in model variables, with its scheme's tolerance scaled by
 // `tol_factor` and its substeps per fast period by `substep_factor`.
 Vector reference_model_state(const Json& config, const Registry& registry, const RunSettings& settings,
@@ -160,39 +179,12 @@ Vector reference_model_state(const Json& config, const Registry& registry, const
   Assembly a = reference_assembly(config, registry, scheme_section, settings);
   if (tol_factor == 1.0 && substep_factor == 1.0) check_reference_cost(config, a, scheme_section, settings.max_steps);
   const double t_end = config["time"]["t_end"];
-  Vector y = a.reformulation->prepare(a.u0);
-  if (t_end > 0.0) {
-    // An adaptive reference goes in chunks of t_end / 256 (it chooses its substeps inside
-    // each): an interrupt stops it within one chunk, and a long one shows its progress.
-    constexpr long adaptive_chunks = 256;
-    const double h = ref["h"].is_null() ? t_end / adaptive_chunks : ref["h"].get<double>() / substep_factor;
-    const long steps = std::max(1L, std::lround(t_end / h));
-    auto last_progress = Clock::now();
-    integrate(a.bind(t_end / static_cast<double>(steps)), y, steps,
-              [&](long n, double t, const Vector&) {
-                if (interrupted())
-                  throw Error(fmt::format("interrupted by signal {} at t = {:.6g}", interrupt_signal(), t));
-                if (progress && seconds_since(last_progress) > 0.5) {
-                  progress(static_cast<double>(n) / static_cast<double>(steps), what);
-                  last_progress = Clock::now();
-                }
-                return true;
-              });
-  }
-  return a.reformulation->read_back(y, t_end);
-}
-
-// The relative error in physical variables that rounding the model state u alone causes:
-// one ulp per entry, alternating in sign. Where to_physical is ill-conditioned (the charged
-// particle's v = (p + B q) / (2 eps)) no reference stored in model variables is better.
-double rounding_floor(const Model& model, const Vector& u) {
-  Vector rounded = u;
-  for (Index i = 0; i < u.size(); ++i) {
-    const double sign = i % 2 == 0 ? 1.0 : -1.0, ulp = std::numeric_limits<double>::epsilon();
-    rounded(i) = Complex(u(i).real() * (1.0 + sign * ulp), u(i).imag() * (1.0 - sign * ulp));
-  }
-  const Vector x = model.to_physical(u);
-  return model.error_norm(model.to_physical(rounded) - x) / model.error_norm(x);
+  if (t_end <= 0.0) return a.reformulation->read_back(a.reformulation->prepare(a.u0), t_end);
+  // An adaptive reference goes in chunks of t_end / 256 (it chooses its substeps inside
+  // each): an interrupt stops it within one chunk, and a long one shows its progress.
+  constexpr long adaptive_chunks = 256;
+  const double h = ref["h"].is_null() ? t_end / adaptive_chunks : ref["h"].get<double>() / substep_factor;
+  return final_model_state(a, t_end, std::max(1L, std::lround(t_end / h)), progress, what);
 }
 
 }  // namespace
@@ -220,7 +212,7 @@ ReferenceSolution compute_reference(const Json& config, const Registry& registry
   if (out.settings.value("estimate_accuracy", true)) {
     const Vector tighter = model->to_physical(reference_model_state(config, registry, settings, 0.1, 2.0, progress, "reference check"));
     out.accuracy = std::max(model->error_norm(out.x - tighter) / model->error_norm(tighter),
-                            rounding_floor(*model, u));
+                            model->rounding_floor(u));
   }
   return out;
 }
@@ -289,19 +281,7 @@ Vector final_state_with_steps(const Json& config, const Registry& registry, cons
   options.bind = false;
   options.context = settings.context;
   Assembly a = assemble(config, registry, options);
-  const double t_end = config["time"]["t_end"];
-  Vector y = a.reformulation->prepare(a.u0);
-  auto last_progress = Clock::now();
-  integrate(a.bind(t_end / static_cast<double>(steps)), y, steps, [&](long n, double t, const Vector& state) {
-    if (!state.allFinite()) throw Error(fmt::format("the state is not finite at t = {:.6g} (step {})", t, n));
-    if (interrupted()) throw Error(fmt::format("interrupted by signal {} at t = {:.6g}", interrupt_signal(), t));
-    if (progress && seconds_since(last_progress) > 0.5) {
-      progress(static_cast<double>(n) / static_cast<double>(steps), what);
-      last_progress = Clock::now();
-    }
-    return true;
-  });
-  return a.model->to_physical(a.reformulation->read_back(y, t_end));
+  return a.model->to_physical(final_model_state(a, config["time"]["t_end"], steps, progress, what));
 }
 
 // The Richardson estimate of the error of x = u_h(t_end) from u_{h/2} and u_{2h}: with

@@ -171,6 +171,16 @@ double Model::error_norm(const Vector& x) const {
   return p ? p->error_norm(x) : x.norm();
 }
 
+double Model::rounding_floor(const Vector& u) const {
+  Vector rounded = u;
+  for (Index i = 0; i < u.size(); ++i) {
+    const double sign = i % 2 == 0 ? 1.0 : -1.0, ulp = std::numeric_limits<double>::epsilon();
+    rounded(i) = Complex(u(i).real() * (1.0 + sign * ulp), u(i).imag() * (1.0 - sign * ulp));
+  }
+  const Vector x = to_physical(u);
+  return error_norm(to_physical(rounded) - x) / std::max(error_norm(x), 1e-300);
+}
+
 Vector Model::linear_flow(double tau, const Vector& u) const {
   Matrix states = u;
   RealVector taus(1);

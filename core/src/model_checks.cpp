@@ -55,18 +55,6 @@ Vector sample_state(const Model& model, const Vector& u0, double phase) {
   return w;
 }
 
-/// The relative error in physical variables that rounding the model state u alone causes: one
-/// ulp per entry, alternating in sign.
-double rounding_floor(const Model& model, const Vector& u) {
-  Vector rounded = u;
-  for (Index i = 0; i < u.size(); ++i) {
-    const double sign = i % 2 == 0 ? 1.0 : -1.0, ulp = std::numeric_limits<double>::epsilon();
-    rounded(i) = Complex(u(i).real() * (1.0 + sign * ulp), u(i).imag() * (1.0 - sign * ulp));
-  }
-  const Vector x = model.to_physical(u);
-  return model.error_norm(model.to_physical(rounded) - x) / std::max(model.error_norm(x), 1e-300);
-}
-
 /// The steps that lie close to a whole number of half fast periods (pi eps), within 0.06 of
 /// one, as "h = 1/16, h = 1/32 are" (empty when none).
 std::string resonant_steps(const std::vector<long>& steps, double eps, double max_half_periods = 1e300) {
@@ -601,7 +589,7 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
     // the state in model variables once per step does to the physical error over the finest
     // run's steps (the charged particle at eps = 1e-6: v = (p + B q) / (2 eps) makes one ulp of
     // p 5e-11 of v, and 512 steps of it reach 1e-9).
-    const double rounding = rounding_floor(*m, u) * static_cast<double>(options_.steps.back());
+    const double rounding = m->rounding_floor(u) * static_cast<double>(options_.steps.back());
     reference_accuracy_[eps] = std::max((coarser - references[eps]).norm() / references[eps].norm(), rounding);
     if (!m->has_hamiltonian_structure() || std::find(epsilons.begin(), epsilons.end(), eps) == epsilons.end())
       continue;  // no energy to conserve (said in the interface checks), or an eps of the dense sample only
