@@ -433,10 +433,11 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
     write_file_atomically(stream_dir + "/result.json", partial.dump(2) + "\n");  // IoError: an I/O failure
     last_checkpoint = Clock::now();
   };
-  result["threads"] = reformulation->threads();  // on the tau grid (tsi --threads)
+  const TwoScaleDiagnostics* diagnostics = reformulation->two_scale_diagnostics();
+  result["threads"] = diagnostics ? diagnostics->threads() : 1;  // on the tau grid (tsi --threads)
   try {
     Vector y = reformulation->prepare(u0);
-    const int data_order = reformulation->data_order_reached();
+    const int data_order = diagnostics ? diagnostics->data_order_reached() : 0;
     if (data_order > 0) {
       result["initial_data_order_reached"] = data_order;
       if (rconf.contains("initial_data_order") && data_order < rconf["initial_data_order"].get<int>())
@@ -534,7 +535,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   result["rhs_evaluations"] = reformulation->evaluations();
   result["tau_roughness_max"] = recorder.roughness_max();
   result["tau_spread_max"] = recorder.spread_max();
-  const std::vector<double> reprepared = reformulation->repreparation_times();
+  const std::vector<double> reprepared = diagnostics ? diagnostics->repreparation_times() : std::vector<double>{};
   result["repreparations"] = {{"count", reprepared.size()}, {"times", reprepared}};
   result["wall_seconds"] = wall;
   {

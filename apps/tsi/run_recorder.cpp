@@ -171,7 +171,8 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
     tracks_[k].final = values[k];
     tracks_[k].max_rel_error = std::max(tracks_[k].max_rel_error, errors[k]);
   }
-  const double roughness = reformulation_.tau_roughness(y);
+  const TwoScaleDiagnostics* tau = reformulation_.two_scale_diagnostics();  // no tau: both 0
+  const double roughness = tau ? tau->tau_roughness(y) : 0.0;
   roughness_max_ = std::max(roughness_max_, roughness);
   if (roughness > roughness_warn_ && !roughness_warned_) {
     roughness_warned_ = true;
@@ -186,7 +187,7 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
   // the spread sits at 2.4e-6 while SE1 follows the solution, then grows a thousandfold within
   // 15 time units while the mass error goes from 1e-5 to 1, and the top of the tau spectrum
   // stays far below tau_roughness_warn.
-  const double spread = reformulation_.tau_spread(y);
+  const double spread = tau ? tau->tau_spread(y) : 0.0;
   spread_max_ = std::max(spread_max_, spread);
   if (n == 1) spread_baseline_ = spread;
   if (n > 1 && !spread_warned_ && spread > 1e-6 && spread > spread_growth_warn_ * spread_baseline_) {

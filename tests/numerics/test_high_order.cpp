@@ -137,7 +137,7 @@ TEST_CASE("prepared data: order k corrects order k - 1 by O(eps^(k-1)), and U(0,
     const Vector back = two_scale->read_back(two_scale->prepare(u0), 0.0);
     CAPTURE(order);
     CHECK((back - u0).norm() <= 1e-15 * u0.norm());
-    CHECK(two_scale->data_order_reached() == order);
+    CHECK(two_scale->two_scale_diagnostics()->data_order_reached() == order);
   }
 }
 
@@ -148,7 +148,7 @@ TEST_CASE("prepared data: at eps = 1 the recursion stops where its corrections s
   const Vector y = two_scale->prepare(model->initial_value());
   CHECK(y.allFinite());
   // Measured: corrections 1.1e-2, 6.2e-3, 4.0e-3, 2.3e-3, then 2.6e-3 (and 4.0 at order 8).
-  CHECK(two_scale->data_order_reached() == 5);
+  CHECK(two_scale->two_scale_diagnostics()->data_order_reached() == 5);
 }
 
 TEST_CASE("eab: uniform order r on Henon-Heiles, errors within 2x across eps") {

@@ -32,7 +32,7 @@ Prepared prepared(const std::string& model_name, double eps, int order, const st
       "two-scale", model, {{"n_tau", 64}, {"initial_data_order", order}, {"initial_data_method", method}});
   const long before = two_scale->evaluations();
   Vector y = two_scale->prepare(model->initial_value());
-  return {y, two_scale->evaluations() - before, two_scale->data_order_reached()};
+  return {y, two_scale->evaluations() - before, two_scale->two_scale_diagnostics()->data_order_reached()};
 }
 
 double relative_difference(const Vector& a, const Vector& b) { return (a - b).norm() / b.norm(); }

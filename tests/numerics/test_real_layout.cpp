@@ -121,9 +121,9 @@ TEST_CASE("real layout: re-preparation and the tau monitors read the real layout
       sr.reset();
       sc.reset();
     }
-    CHECK(real.reformulation->tau_spread(yr) == doctest::Approx(complex.reformulation->tau_spread(yc)).epsilon(1e-10));
-    CHECK(real.reformulation->tau_roughness(yr) ==
-          doctest::Approx(complex.reformulation->tau_roughness(yc)).epsilon(1e-8));
+    CHECK(real.reformulation->two_scale_diagnostics()->tau_spread(yr) == doctest::Approx(complex.reformulation->two_scale_diagnostics()->tau_spread(yc)).epsilon(1e-10));
+    CHECK(real.reformulation->two_scale_diagnostics()->tau_roughness(yr) ==
+          doctest::Approx(complex.reformulation->two_scale_diagnostics()->tau_roughness(yc)).epsilon(1e-8));
     const Vector ur = real.reformulation->read_back(yr, t), uc = complex.reformulation->read_back(yc, t);
     CHECK((ur - uc).norm() <= 1e-12 * uc.norm());
     CHECK(ur.imag().norm() == 0.0);  // a real U reads back real
@@ -141,7 +141,7 @@ TEST_CASE("real layout: on two tau-grid threads the field is the one-thread fiel
       const tsi::test::ContextSetting setting(tsi::test::ContextSetting::tau_grid(threads, 1));
       r = h.reformulation("two-scale", model, {{"n_tau", 64}});
     }
-    REQUIRE(r->threads() == threads);
+    REQUIRE(r->two_scale_diagnostics()->threads() == threads);
     const Vector y = r->prepare(model->initial_value()) * 3.0;
     Vector out;
     r->nonlinear(0.0, y, out);

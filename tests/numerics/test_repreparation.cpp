@@ -54,7 +54,7 @@ TEST_CASE("re-preparation: U(t_n, s_n) = v_n exactly, so the solution read back 
       CAPTURE(order);
       CHECK((after - before).norm() <= 1e-13 * before.norm());
       CHECK((y - stepped).norm() > 1e-12 * stepped.norm());  // U itself was rebuilt
-      CHECK(a.reformulation->repreparation_times() == std::vector<double>{h});
+      CHECK(a.reformulation->two_scale_diagnostics()->repreparation_times() == std::vector<double>{h});
     }
 }
 
@@ -121,7 +121,7 @@ TEST_CASE("re-preparation: auto brings the charged particle at eps = 1 below 1e-
       worst = std::max(worst, std::abs(a.model->energy(a.reformulation->read_back(state, t)) - e0) / std::abs(e0));
       return std::isfinite(worst) && worst < 10.0;
     });
-    *repreparations = static_cast<long>(a.reformulation->repreparation_times().size());
+    *repreparations = static_cast<long>(a.reformulation->two_scale_diagnostics()->repreparation_times().size());
     return worst;
   };
   long count = 0;

@@ -79,7 +79,7 @@ TEST_CASE("tau grid threads: NLS and Klein-Gordon on two threads give the one-th
       ThreadSetting setting(threads, 1);
       auto model = h.model_with(name, 0.01, {{"n_x", 32}});
       auto two_scale = h.reformulation("two-scale", model, {{"n_tau", 64}});
-      CHECK(two_scale->threads() == (tsi::tau_grid_threads_available() ? threads : 1));
+      CHECK(two_scale->two_scale_diagnostics()->threads() == (tsi::tau_grid_threads_available() ? threads : 1));
       const Vector y = two_scale->prepare(model->initial_value());
       auto se1 = h.scheme("se1");
       return std::make_pair(evaluate_nonlinear(*two_scale, y), tsi::test::solve(*model, *two_scale, *se1, 0.5, 4));
@@ -98,22 +98,22 @@ TEST_CASE("tau grid threads: only large grids of models with independent binding
     ThreadSetting setting(2, 4096);  // the default threshold
     // 16 x 128 = 2048 values: below the threshold. 16 x 256 = 4096: split.
     auto small = h.reformulation("two-scale", h.model_with("nls", 0.01, {{"n_x", 16}}), {{"n_tau", 128}});
-    CHECK(small->threads() == 1);
+    CHECK(small->two_scale_diagnostics()->threads() == 1);
     auto large = h.reformulation("two-scale", h.model_with("nls", 0.01, {{"n_x", 16}}), {{"n_tau", 256}});
-    CHECK(large->threads() == (tsi::tau_grid_threads_available() ? 2 : 1));
+    CHECK(large->two_scale_diagnostics()->threads() == (tsi::tau_grid_threads_available() ? 2 : 1));
   }
   {
     ThreadSetting setting(2, 1);
     // Henon-Heiles has 4 rows: never more threads than rows.
     auto hh = h.reformulation("two-scale", h.model("henon-heiles", 0.01), {{"n_tau", 64}});
-    CHECK(hh->threads() == (tsi::tau_grid_threads_available() ? 2 : 1));
+    CHECK(hh->two_scale_diagnostics()->threads() == (tsi::tau_grid_threads_available() ? 2 : 1));
     ThreadSetting many(8, 1);
     auto hh8 = h.reformulation("two-scale", h.model("henon-heiles", 0.01), {{"n_tau", 64}});
-    CHECK(hh8->threads() == (tsi::tau_grid_threads_available() ? 4 : 1));
+    CHECK(hh8->two_scale_diagnostics()->threads() == (tsi::tau_grid_threads_available() ? 4 : 1));
     // A model that does not declare independent bindings (the default) stays on one thread.
     auto shared = std::make_shared<ThrowingModel>(false);
     auto r = h.reformulation("two-scale", shared, {{"n_tau", 64}});
-    CHECK(r->threads() == 1);
+    CHECK(r->two_scale_diagnostics()->threads() == 1);
     CHECK(shared->bindings_ == 1);
   }
   CHECK_THROWS_AS(tsi::Context::with_threads(0, 1), tsi::ConfigError);
@@ -125,7 +125,7 @@ TEST_CASE("tau grid threads: a model error on another thread reaches the caller"
   ThreadSetting setting(2, 1);
   auto model = std::make_shared<ThrowingModel>(true);
   auto r = h.reformulation("two-scale", model, {{"n_tau", 64}});
-  REQUIRE(r->threads() == 2);
+  REQUIRE(r->two_scale_diagnostics()->threads() == 2);
   const Vector y = Vector::Ones(r->size());
   CHECK_THROWS_WITH(evaluate_nonlinear(*r, y), "field failed on a later tau range");
   // The team is usable again after the failure (no thread left waiting at a barrier).

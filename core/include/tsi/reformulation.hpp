@@ -8,6 +8,26 @@
 
 namespace tsi {
 
+/// What a two-scale reformulation reports besides its problem: its tau monitors and what its
+/// preparation did. The run's observers (the recorder) ask it at their own cadence.
+class TSI_API TwoScaleDiagnostics {
+ public:
+  virtual ~TwoScaleDiagnostics() = default;
+  /// Fraction of the energy of y in the top quarter of the tau spectrum.
+  virtual double tau_roughness(const Vector& y) const = 0;
+  /// Fraction of the energy of y away from its tau mean (the non-zero tau modes). Each
+  /// characteristic tau - t/eps = const of U is a trajectory of the model; this measures how
+  /// far they have spread apart, which the run recorder watches for growth.
+  virtual double tau_spread(const Vector& y) const = 0;
+  /// The times t_n at which the state was re-prepared.
+  virtual std::vector<double> repreparation_times() const = 0;
+  /// The order of the prepared data of the last prepare(): below the configured order when
+  /// the asymptotic recursion stopped at its smallest correction.
+  virtual int data_order_reached() const = 0;
+  /// Threads the tau grid's evaluations use (tsi::Context::tau_grid).
+  virtual int threads() const = 0;
+};
+
 /// Turns a model into a Problem (SPEC.md section 2) and reads the answer back:
 /// two-scale U(t, tau), filtered v = e^{-JM t/eps} u, or direct u.
 class TSI_API Reformulation : public Problem {
@@ -18,20 +38,8 @@ class TSI_API Reformulation : public Problem {
   virtual Vector prepare(const Vector& u0) = 0;
   /// u(t) in model variables from the problem state y at time t.
   virtual Vector read_back(const Vector& y, double t) = 0;
-  /// Fraction of the energy of y in the top quarter of the tau spectrum (0 without tau).
-  virtual double tau_roughness(const Vector& /*y*/) const { return 0.0; }
-  /// Fraction of the energy of y away from its tau mean (the non-zero tau modes; 0 without
-  /// tau). Each characteristic tau - t/eps = const of U is a trajectory of the model; this
-  /// measures how far they have spread apart, which the run recorder watches for growth.
-  virtual double tau_spread(const Vector& /*y*/) const { return 0.0; }
-  /// The times t_n at which the state was re-prepared (two-scale; empty otherwise).
-  virtual std::vector<double> repreparation_times() const { return {}; }
-  /// The order of the prepared data of the last prepare() (two-scale; 0 otherwise): below the
-  /// configured order when the asymptotic recursion stopped at its smallest correction.
-  virtual int data_order_reached() const { return 0; }
-  /// Threads the reformulation's evaluations use (two-scale on a large tau grid: see
-  /// tsi::Context::tau_grid; 1 otherwise).
-  virtual int threads() const { return 1; }
+  /// The two-scale diagnostics (null for the filtered and direct problems, which have no tau).
+  virtual const TwoScaleDiagnostics* two_scale_diagnostics() const { return nullptr; }
 
   const Model& model() const { return *model_; }
 

@@ -22,7 +22,7 @@ namespace tsi {
 /// Its parts: the tau grid (TauGrid: its modes, transforms and f_tau on it), the prepared data
 /// (PreparedData), their re-preparation between steps (Repreparer), and this, the problem the
 /// schemes integrate, with read-back and the tau monitors.
-class TwoScale final : public Reformulation {
+class TwoScale final : public Reformulation, public TwoScaleDiagnostics {
  public:
   /// The largest order of prepared data.
   static constexpr int max_data_order = PreparedData::max_order;
@@ -64,6 +64,7 @@ class TwoScale final : public Reformulation {
   Vector prepare(const Vector& u0) override;
   /// u(t) = e^{JM t/eps} U(t, t/eps), U evaluated off the grid by its interpolant.
   Vector read_back(const Vector& y, double t) override;
+  const TwoScaleDiagnostics* two_scale_diagnostics() const override { return this; }
   double tau_roughness(const Vector& y) const override;
   double tau_spread(const Vector& y) const override;
   /// Re-prepares U when the rule says so: v_n = U(t_n, s_n), s_n = t_n/eps mod 2 pi, and U
