@@ -54,26 +54,16 @@ void FusedTauGrid::filtered_field(const RealVector& taus, MatrixRef states, Matr
 
 namespace {
 
-// The binding of a model without the fused capability: flow, field and flow back with the
-// stored phases.
+// A binding that calls source.filtered_field with the stored phases: a Model (flow, field and
+// flow back, for a model without the fused capability) or a FusedTauGrid.
+template <class Source>
 class StoredPhasesField final : public TauGridField {
  public:
-  StoredPhasesField(const Model& model, RealVector taus) : model_(model), taus_(std::move(taus)) {}
-  void evaluate(MatrixRef states, MatrixRef out) override { model_.filtered_field(taus_, states, out); }
+  StoredPhasesField(const Source& source, RealVector taus) : source_(source), taus_(std::move(taus)) {}
+  void evaluate(MatrixRef states, MatrixRef out) override { source_.filtered_field(taus_, states, out); }
 
  private:
-  const Model& model_;
-  RealVector taus_;
-};
-
-// The same with the fused capability's filtered_field.
-class StoredPhasesFusedField final : public TauGridField {
- public:
-  StoredPhasesFusedField(const FusedTauGrid& fused, RealVector taus) : fused_(fused), taus_(std::move(taus)) {}
-  void evaluate(MatrixRef states, MatrixRef out) override { fused_.filtered_field(taus_, states, out); }
-
- private:
-  const FusedTauGrid& fused_;
+  const Source& source_;
   RealVector taus_;
 };
 
@@ -85,12 +75,12 @@ class StoredPhasesFusedField final : public TauGridField {
 }  // namespace
 
 std::unique_ptr<TauGridField> bind_filtered_field(const FusedTauGrid& fused, const RealVector& taus) {
-  return std::make_unique<StoredPhasesFusedField>(fused, taus);
+  return std::make_unique<StoredPhasesField<FusedTauGrid>>(fused, taus);
 }
 
 std::unique_ptr<TauGridField> Model::bind_tau_grid(const RealVector& taus) const {
   if (const FusedTauGrid* fused = fused_tau_grid()) return fused->bind_tau_grid(taus);
-  return std::make_unique<StoredPhasesField>(*this, taus);
+  return std::make_unique<StoredPhasesField<Model>>(*this, taus);
 }
 
 bool Model::independent_tau_grid_bindings() const {

@@ -143,10 +143,11 @@ class PythonModel final : public tsi::Model, public tsi::HamiltonianStructure, p
 
   tsi::Index dim() const override { return dim_; }
   bool is_complex() const override { return complex_; }
-  // `hamiltonian = False` declares no Hamiltonian structure; the fused capability is the
-  // binding of the run's tau grid as one numpy array (filtered_field if the class has it).
+  // `hamiltonian = False` declares no Hamiltonian structure; a class with filtered_field
+  // declares the fused capability (its tau grid handed over as one numpy array), one without
+  // gets tsi's flow, field and flow back.
   const tsi::HamiltonianStructure* hamiltonian() const override { return hamiltonian_ ? this : nullptr; }
-  const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
+  const tsi::FusedTauGrid* fused_tau_grid() const override { return has_filtered_ ? this : nullptr; }
   double max_linear_frequency() const override { return max_frequency_; }
 
   void linear_flow(const tsi::RealVector& taus, tsi::MatrixRef states) const override {
@@ -162,7 +163,6 @@ class PythonModel final : public tsi::Model, public tsi::HamiltonianStructure, p
   }
 
   void filtered_field(const tsi::RealVector& taus, tsi::MatrixRef states, tsi::MatrixRef out) const override {
-    if (!has_filtered_) return three_passes(taus, states, out);
     call_python(name_, "filtered_field", [&] {
       store(out, self().attr("filtered_field")(taus, batch(states)), "filtered_field");
     });
@@ -182,7 +182,6 @@ class PythonModel final : public tsi::Model, public tsi::HamiltonianStructure, p
       }
     }
     void evaluate(tsi::MatrixRef states, tsi::MatrixRef out) override {
-      if (!model_.has_filtered_) return model_.three_passes(taus_, states, out);
       call_python(model_.name_, "filtered_field", [&] {
         model_.store(out, model_.self().attr("filtered_field")(py::handle(array_), model_.batch(states)),
                      "filtered_field");
@@ -228,14 +227,6 @@ class PythonModel final : public tsi::Model, public tsi::HamiltonianStructure, p
 
  private:
   py::handle self() const { return py::handle(self_); }
-
-  // f_tau of a class without filtered_field: flow, field, flow back.
-  void three_passes(const tsi::RealVector& taus, tsi::MatrixRef states, tsi::MatrixRef out) const {
-    linear_flow(taus, states);
-    nonlinear_field(states, out);
-    const tsi::RealVector minus_taus = -taus;
-    linear_flow(minus_taus, out);
-  }
 
   // States as numpy arrays, one column per state: float64 for a real model (the real parts),
   // complex128 otherwise.
