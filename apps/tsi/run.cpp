@@ -240,14 +240,22 @@ Json state_entry(const Vector& x, bool complex_state, const std::vector<std::uin
 namespace {
 
 // The shape of the state files: model.u0's file's when the run started from one (an N x 4
-// particle array stays one), else (dim,).
-std::vector<std::uint64_t> state_shape(const Json& config, Index dim) {
-  const std::vector<std::uint64_t> flat = {static_cast<std::uint64_t>(dim)};
+// particle array stays one), else the model's physical shape (a grid's (n_x, n_y, n_z)), else
+// (dim,).
+std::vector<std::uint64_t> state_shape(const Json& config, const Model& model, Index dim) {
+  std::vector<std::uint64_t> flat = {static_cast<std::uint64_t>(dim)};
+  std::vector<std::uint64_t> declared;
+  std::uint64_t count = 1;
+  for (const Index n : model.physical_shape()) {
+    declared.push_back(static_cast<std::uint64_t>(n));
+    count *= static_cast<std::uint64_t>(n);
+  }
+  if (count == flat.front()) flat = declared;
   const Json& u0 = config["model"].value("u0", Json());
   if (!u0.is_string()) return flat;
   try {
     const NpyHeader header = read_npy_header(u0.get<std::string>());
-    return header.count == flat.front() ? header.shape : flat;
+    return header.count == static_cast<std::uint64_t>(dim) ? header.shape : flat;
   } catch (const Error&) {  // gone since the run read it: the plain shape
     return flat;
   }
@@ -507,7 +515,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   result["t_end"] = t_end;
   result["t_reached"] = recorder.t_reached();
   outcome.complex_state = model->is_complex();
-  outcome.state_shape = state_shape(config, x.size());
+  outcome.state_shape = state_shape(config, *model, x.size());
   outcome.u_final = x;
   result["u_final"] = state_entry(x, outcome.complex_state, outcome.state_shape, u_final_file);
   if (dense) result["dense_output"] = dense_output_entry(*dense, outcome);

@@ -10,12 +10,22 @@
 #include <mutex>
 #include <string>
 
+#include "fftw_planner.hpp"
 #include "tsi/error.hpp"
 
 namespace tsi {
+namespace detail {
+std::mutex& fftw_planner_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+bool fftw_threads_ready() {
+  static const bool ready = fftw_init_threads() != 0;
+  return ready;
+}
+}  // namespace detail
+
 namespace {
-// FFTW's planner is not thread-safe; execution of distinct plans is.
-std::mutex planner_mutex;
 
 // Rows per contiguous block of a buffered batch, and the smallest batch that is buffered
 // (measured, 256-point transforms: 4 rows best from 64 to 1024 rows; at 16 rows the strided
@@ -31,8 +41,8 @@ fftw_complex* raw(Complex* p) { return reinterpret_cast<fftw_complex*>(p); }
 FftBatch::FftBatch(int n, int howmany, int parts, ThreadLimit fftw_threads) : n_(n), howmany_(howmany) {
   if (n <= 0 || howmany <= 0) throw Error("FftBatch: sizes must be positive");
   if (parts < 1 || parts > howmany) throw Error("FftBatch: parts must be from 1 to the number of rows");
-  std::lock_guard<std::mutex> lock(planner_mutex);
-  static const bool threads_ready = fftw_init_threads() != 0;
+  std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
+  const bool threads_ready = detail::fftw_threads_ready();
   const long values = static_cast<long>(n) * howmany;
   const int fftw_team = threads_ready ? fftw_threads.for_size(values) : 1;
   const bool fftw_split = fftw_team > 1;
@@ -110,7 +120,7 @@ void FftBatch::release() {
 }
 
 FftBatch::~FftBatch() {
-  std::lock_guard<std::mutex> lock(planner_mutex);
+  std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
   release();
 }
 
@@ -221,8 +231,8 @@ RealFftBatch::RealFftBatch(int n, int howmany, int parts)
   if (n <= 0 || n % 2 != 0 || howmany <= 0) throw Error("RealFftBatch: n must be positive and even, howmany positive");
   if (parts < 1 || parts > howmany) throw Error("RealFftBatch: parts must be from 1 to the number of rows");
   for (int p = 0; p <= parts; ++p) part_rows_.push_back(static_cast<int>(static_cast<long>(howmany) * p / parts));
-  std::lock_guard<std::mutex> lock(planner_mutex);
-  static const bool threads_ready = fftw_init_threads() != 0;
+  std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
+  const bool threads_ready = detail::fftw_threads_ready();
   if (threads_ready) fftw_plan_with_nthreads(1);  // the callers' threads split the rows
   // FFTW_ESTIMATE plans never touch the arrays they are made with, and FFTW_UNALIGNED plans
   // run on any: small stand-ins serve for planning, the callers' arrays at execution.
@@ -254,7 +264,7 @@ void RealFftBatch::release() {
 }
 
 RealFftBatch::~RealFftBatch() {
-  std::lock_guard<std::mutex> lock(planner_mutex);
+  std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
   release();
 }
 

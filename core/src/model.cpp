@@ -141,6 +141,11 @@ double Model::energy(const Vector& u) const {
   return oscillatory_energy(u) + remainder_energy(u) + h->H1(u);
 }
 
+std::vector<Index> Model::physical_shape() const {
+  const PhysicalVariables* p = physical_variables();
+  return p ? p->physical_shape() : std::vector<Index>{dim()};
+}
+
 Index Model::physical_dim() const {
   const PhysicalVariables* p = physical_variables();
   return p ? p->physical_dim() : dim();

@@ -122,6 +122,8 @@ class TSI_API Model {
   Vector to_physical(const Vector& u) const;
   /// The norm of relative errors, on physical states (Euclidean without physical variables).
   double error_norm(const Vector& x) const;
+  /// The shape of a physical state in C order (u_final.npy's): (physical_dim()) by default.
+  std::vector<Index> physical_shape() const;
   /// The relative error in physical variables that rounding the model state u alone causes
   /// (one ulp per entry, alternating in sign): no solution held in model variables is more
   /// accurate. Large where to_physical is ill-conditioned (the charged particle's

@@ -7,6 +7,7 @@
 // Hamiltonian structure, `tsi check` skips what a model does not declare).
 #include <functional>
 #include <memory>
+#include <vector>
 #include <string>
 
 #include "tsi/export.hpp"
@@ -97,6 +98,9 @@ class TSI_API PhysicalVariables {
   virtual Vector to_physical(const Vector& u) const = 0;
   /// The norm relative errors are measured in, on physical states (Euclidean by default).
   virtual double error_norm(const Vector& x) const { return x.norm(); }
+  /// The shape of a physical state as an array in C order, the shape of u_final.npy (a grid's
+  /// (n_x, n_y, n_z)); by default flat, (physical_dim()).
+  virtual std::vector<Index> physical_shape() const { return {physical_dim()}; }
 };
 
 /// A quantity a model declares as conserved (or nearly) besides H, I and m: runs record its

@@ -1,8 +1,9 @@
 // The nonlinear Klein-Gordon equation in the non-relativistic limit (SPEC.md section 6):
-//     e^2 z_tt - z_xx + z / e^2 + lambda z^3 = 0,   x in [0, 2 pi) periodic, z real,
+//     e^2 z_tt - lap z + z / e^2 + lambda z^3 = 0,   x in [0, 2 pi)^d periodic, z real, d = 1, 2, 3,
 // with tsi's eps = e^2 (time is not rescaled), discretised by the Fourier pseudospectral
-// method on the grid x_j = 2 pi j / n_x (n_x even). Reference: Chartier, Crouseilles, Lemou,
-// Mehats, Numer. Math. 129 (2015) 211-250.
+// method on tsi::SpectralGrid's N = n_x [x n_y [x n_z]] points (each even). Reference:
+// Chartier, Crouseilles, Lemou, Mehats, Numer. Math. 129 (2015) 211-250. Written out below in
+// 1-D; in d dimensions k^2 is |k|^2 = k_1^2 + .. + k_d^2, sqrt(2 pi) is (2 pi)^{d/2} and n_x is N.
 //
 // Variables. q = z, p = e^2 z_t, and for the wave number k (FFT order, the Nyquist index taken
 // as k = n_x/2) a_k = (1 + eps k^2)^(1/4), Q_k = a_k q_k, P_k = p_k / a_k, w_k = Q_k - i P_k,
@@ -42,17 +43,21 @@
 // z(x, 0) the real part of the NLS paper's u0, the momentum of the same size and shape. Only odd
 // modes, decaying like e^{-0.88 |k|} (k = 3, 5, 7: 0.11, 0.018, 0.003). Well prepared uniformly
 // in eps: e^2 z_t(0) = (1 - e^2 d_xx)^{1/2} of an eps-independent smooth function is O(1).
+// In 2-D and 3-D the products over the directions: z(x, 0) = prod_i cos x_i / (1 + sin^2 x_i),
+// and the momentum part (1/2) prod_i sin x_i / (1 + cos^2 x_i).
+#include <array>
 #include <cmath>
 #include <complex>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "tsi/error.hpp"
-#include "tsi/grid_fft.hpp"
 #include "tsi/model.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/plugin.hpp"
+#include "tsi/spectral_grid.hpp"
 
 namespace {
 
@@ -77,13 +82,20 @@ class KleinGordon final : public tsi::Model,
                           public tsi::PhysicalVariables {
  public:
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
-  KleinGordon(double eps, int n_x, double lambda, tsi::ThreadLimit fftw_threads = {})
-      : Model(eps), n_x_(n_x), lambda_(lambda), inverse_a_(n_x), remainder_(n_x), batches_(n_x, fftw_threads) {
-    for (int j = 0; j < n_x; ++j) {
-      const double k = 2 * j <= n_x ? j : j - n_x;  // the Nyquist index as k = n_x / 2
-      const double root = std::sqrt(1.0 + eps * k * k);
+  KleinGordon(double eps, std::vector<int> shape, double lambda, tsi::ThreadLimit fftw_threads = {})
+      : Model(eps),
+        grid_(std::move(shape)),
+        n_x_(grid_.points()),
+        lambda_(lambda),
+        volume_(std::pow(tsi::two_pi, grid_.dims())),
+        inverse_a_(n_x_),
+        remainder_(n_x_),
+        batches_(grid_, fftw_threads) {
+    for (Index j = 0; j < n_x_; ++j) {
+      const double k2 = grid_.laplacian_symbol()(j);  // |k|^2, the Nyquist index as +n/2
+      const double root = std::sqrt(1.0 + eps * k2);
       inverse_a_(j) = 1.0 / std::sqrt(root);
-      remainder_(j) = k * k / (1.0 + root);
+      remainder_(j) = k2 / (1.0 + root);
     }
     batch(1);  // the single-state plans (filtered, direct, invariants)
   }
@@ -119,13 +131,13 @@ class KleinGordon final : public tsi::Model,
   class GridField final : public tsi::TauGridField {
    public:
     GridField(const KleinGordon& model, const tsi::RealVector& taus)
-        : model_(model), phases_(taus), batch_(model.n_x_, taus.size(), model.batches_.fftw_threads()) {}
+        : model_(model), phases_(taus), batch_(model.grid_, taus.size(), model.batches_.fftw_threads()) {}
     void evaluate(MatrixRef c, MatrixRef out) override { model_.fused_field<true>(phases_, batch_, c, out); }
 
    private:
     const KleinGordon& model_;
     Phases phases_;
-    tsi::GridFft batch_;
+    tsi::GridTransforms batch_;
   };
 
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
@@ -140,26 +152,27 @@ class KleinGordon final : public tsi::Model,
   // sqrt(2 pi)), and leaves as e^{-i tau} on the way out. Without Rotate, tau = 0 (the field
   // N itself; `phases` is not read). `c` is not written.
   template <bool Rotate>
-  void fused_field(const Phases& phases, tsi::GridFft& b, ConstMatrixRef c, MatrixRef out) const {
-    auto w = b.data();  // row j: state j
+  void fused_field(const Phases& phases, tsi::GridTransforms& b, ConstMatrixRef c, MatrixRef out) const {
+    auto w = b.data();  // column j: state j
     const Index cols = c.cols();
-    for (Index k = 0; k < n_x_; ++k)
-      for (Index j = 0; j < cols; ++j) w(j, k) = inverse_a_(k) * c(k, j);
+    for (Index j = 0; j < cols; ++j)
+      for (Index k = 0; k < n_x_; ++k) w(k, j) = inverse_a_(k) * c(k, j);
     b.backward();
     // backward(a^{-1} c) = sqrt(2 pi) g; z^3 is Re(.)^3 / (2 pi)^{3/2}, and the field's factor
     // sqrt(2 pi) / n_x: lambda Re(.)^3 / (2 pi n_x), real, before the forward transform.
-    const double scale = lambda_ / (tsi::two_pi * n_x_);
-    for (Index k = 0; k < n_x_; ++k)
-      for (Index j = 0; j < cols; ++j) {
-        const double re =
-            Rotate ? phases.cos(j) * w(j, k).real() - phases.sin(j) * w(j, k).imag() : w(j, k).real();
-        w(j, k) = scale * re * re * re;
+    const double scale = lambda_ / (volume_ * point_count());
+    for (Index j = 0; j < cols; ++j) {
+      const double co = Rotate ? phases.cos(j) : 1.0, si = Rotate ? phases.sin(j) : 0.0;
+      for (Index k = 0; k < n_x_; ++k) {
+        const double re = Rotate ? co * w(k, j).real() - si * w(k, j).imag() : w(k, j).real();
+        w(k, j) = scale * re * re * re;
       }
+    }
     b.forward();
     // out = i e^{-i tau} a^{-1} F: i e^{-i tau} = sin tau + i cos tau.
     for (Index j = 0; j < cols; ++j) {
       const Complex turn = Rotate ? Complex(phases.sin(j), phases.cos(j)) : Complex(0.0, 1.0);
-      for (Index k = 0; k < n_x_; ++k) out(k, j) = inverse_a_(k) * times(w(j, k), turn);
+      for (Index k = 0; k < n_x_; ++k) out(k, j) = inverse_a_(k) * times(w(k, j), turn);
     }
   }
 
@@ -168,25 +181,25 @@ class KleinGordon final : public tsi::Model,
   void nonlinear_field_derivative(ConstMatrixRef c, ConstMatrixRef d, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
     const Index cols = c.cols();
-    tsi::GridFft& b = batch(cols);
+    tsi::GridTransforms& b = batch(cols);
     tsi::Matrix& grid = b.scratch();
-    auto w = b.data();
-    for (Index k = 0; k < n_x_; ++k)
-      for (Index j = 0; j < cols; ++j) w(j, k) = inverse_a_(k) * c(k, j);
+    auto w = b.data();  // column j: state j
+    for (Index j = 0; j < cols; ++j)
+      for (Index k = 0; k < n_x_; ++k) w(k, j) = inverse_a_(k) * c(k, j);
     b.backward();
     grid = w;
-    for (Index k = 0; k < n_x_; ++k)
-      for (Index j = 0; j < cols; ++j) w(j, k) = inverse_a_(k) * d(k, j);
+    for (Index j = 0; j < cols; ++j)
+      for (Index k = 0; k < n_x_; ++k) w(k, j) = inverse_a_(k) * d(k, j);
     b.backward();
-    const double scale = 3.0 * lambda_ / (tsi::two_pi * n_x_);
-    for (Index k = 0; k < n_x_; ++k)
-      for (Index j = 0; j < cols; ++j) {
-        const double z = grid(j, k).real();
-        w(j, k) = scale * z * z * w(j, k).real();
+    const double scale = 3.0 * lambda_ / (volume_ * point_count());
+    for (Index j = 0; j < cols; ++j)
+      for (Index k = 0; k < n_x_; ++k) {
+        const double z = grid(k, j).real();
+        w(k, j) = scale * z * z * w(k, j).real();
       }
     b.forward();
     for (Index j = 0; j < cols; ++j)
-      for (Index k = 0; k < n_x_; ++k) out(k, j) = inverse_a_(k) * Complex(0.0, 1.0) * w(j, k);
+      for (Index k = 0; k < n_x_; ++k) out(k, j) = inverse_a_(k) * Complex(0.0, 1.0) * w(k, j);
   }
 
   void apply_M(const Vector& u, Vector& out) const override { out = u; }
@@ -195,11 +208,11 @@ class KleinGordon final : public tsi::Model,
   // (lambda / 4) (2 pi / n_x) sum z_j^4 with z_j = Re backward(a^{-1} c)_j / sqrt(2 pi).
   double H1(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridFft& b = batch(1);
+    tsi::GridTransforms& b = batch(1);
     auto w = b.data();
-    w.row(0) = inverse_a_.cwiseProduct(c).transpose();
+    w.col(0) = inverse_a_.cwiseProduct(c);
     b.backward();
-    return lambda_ * w.row(0).real().array().pow(4).sum() / (4.0 * tsi::two_pi * n_x_);
+    return lambda_ * w.col(0).real().array().pow(4).sum() / (4.0 * volume_ * point_count());
   }
 
   const tsi::RealVector& linear_remainder() const override { return remainder_; }
@@ -213,57 +226,66 @@ class KleinGordon final : public tsi::Model,
   // v0(x) = cos x / (1 + sin^2 x) - (i/2) sin x / (1 + cos^2 x) (see the header).
   Vector initial_value() const override {
     Vector v(n_x_);
-    for (Index j = 0; j < n_x_; ++j) {
-      const double x = tsi::two_pi * static_cast<double>(j) / n_x_, s = std::sin(x), co = std::cos(x);
-      v(j) = Complex(co / (1.0 + s * s), -0.5 * s / (1.0 + co * co));
-    }
+    grid_.for_each_point([&](Index j, const std::array<double, 3>& x) {
+      double z = 1.0, p = 1.0;  // the products over the directions
+      for (int i = 0; i < grid_.dims(); ++i) {
+        const double s = std::sin(x[static_cast<std::size_t>(i)]), co = std::cos(x[static_cast<std::size_t>(i)]);
+        z = i ? z * (co / (1.0 + s * s)) : co / (1.0 + s * s);
+        p = i ? p * (s / (1.0 + co * co)) : s / (1.0 + co * co);
+      }
+      v(j) = Complex(z, -0.5 * p);
+    });
     return from_physical(v);
   }
 
   Index physical_dim() const override { return n_x_; }
+  std::vector<Index> physical_shape() const override { return {grid_.shape().begin(), grid_.shape().end()}; }
 
   // Grid samples of v -> c = sqrt(2 pi) / n_x * a forward(v).
   Vector from_physical(const Vector& v) const override {
     if (v.size() != n_x_)
-      throw tsi::ConfigError(
-          "model.u0", "got " + std::to_string(v.size()) + " samples, expected n_x = " + std::to_string(n_x_));
+      throw tsi::ConfigError("model.u0", "got " + std::to_string(v.size()) + " samples, expected " +
+                                             std::to_string(n_x_) + " (the grid " + grid_.describe() + ")");
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridFft& b = batch(1);
+    tsi::GridTransforms& b = batch(1);
     auto w = b.data();
-    w.row(0) = v.transpose();
+    w.col(0) = v;
     b.forward();
-    return (std::sqrt(tsi::two_pi) / n_x_) * w.row(0).transpose().cwiseQuotient(inverse_a_.cast<Complex>());
+    return (std::sqrt(volume_) / point_count()) * w.col(0).cwiseQuotient(inverse_a_.cast<Complex>());
   }
 
   // c -> v = backward(a^{-1} c) / sqrt(2 pi).
   Vector to_physical(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridFft& b = batch(1);
+    tsi::GridTransforms& b = batch(1);
     auto w = b.data();
-    w.row(0) = inverse_a_.cwiseProduct(c).transpose();
+    w.col(0) = inverse_a_.cwiseProduct(c);
     b.backward();
-    return w.row(0).transpose() / std::sqrt(tsi::two_pi);
+    return w.col(0) / std::sqrt(volume_);
   }
 
   // Discrete L2 norm of grid samples.
-  double error_norm(const Vector& v) const override { return std::sqrt(tsi::two_pi / n_x_) * v.norm(); }
+  double error_norm(const Vector& v) const override { return std::sqrt(volume_ / point_count()) * v.norm(); }
 
  private:
   // The transforms for batches of `columns` states, planned on first use and kept. Callers
   // hold mutex_.
-  tsi::GridFft& batch(Index columns) const { return batches_.get(columns); }
+  tsi::GridTransforms& batch(Index columns) const { return batches_.get(columns); }
+  double point_count() const { return static_cast<double>(n_x_); }
 
   // a b, written out: std::complex's operator* tests every product for inf/NaN.
   static Complex times(Complex a, Complex b) {
     return {a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real()};
   }
 
-  int n_x_;
+  tsi::SpectralGrid grid_;
+  Index n_x_;       // the grid's points, N
   double lambda_;
+  double volume_;   // (2 pi)^d
   tsi::RealVector inverse_a_;  // a_k^{-1} = (1 + eps k^2)^{-1/4}
   tsi::RealVector remainder_;  // A_k = k^2 / (1 + sqrt(1 + eps k^2))
   mutable std::mutex mutex_;   // the batches' buffers are shared work space
-  mutable tsi::GridFftPool batches_;
+  mutable tsi::GridTransformsPool batches_;
 };
 
 void register_klein_gordon(tsi::Registry& registry) {
@@ -271,17 +293,12 @@ void register_klein_gordon(tsi::Registry& registry) {
   entry.info.name = "klein-gordon";
   entry.info.aliases = {"kg"};
   entry.info.summary =
-      "nonlinear Klein-Gordon e^2 z_tt - z_xx + z/e^2 + lambda z^3 = 0 on the torus, eps = e^2, Fourier in x, "
-      "dim n_x";
-  entry.info.params = {
-      tsi::integer_param("n_x", 16, "Fourier modes (grid points) in x; u0 is given as samples of v on this grid")
-          .check(
-              [](const tsi::Json& v) {
-                return v.get<long>() >= 2 && v.get<long>() <= (1L << 20) && v.get<long>() % 2 == 0;
-              },
-              "an even integer in [2, 1048576]"),
+      "nonlinear Klein-Gordon e^2 z_tt - lap z + z/e^2 + lambda z^3 = 0 on the torus [0, 2 pi)^dims, eps = e^2, "
+      "Fourier in space, dim n_x [n_y [n_z]]";
+  entry.info.params = tsi::spectral_grid_params("samples of v");
+  entry.info.params.push_back(
       tsi::number_param("lambda", 1.0, "coefficient of the cubic term lambda z^3")
-          .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number")};
+          .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number"));
   entry.default_n_tau = 32;
   entry.nonlinearity_degree = 3;
   // From h = 1/16: coarser steps are pre-asymptotic for the modes 3, 5, 7 of the default u0
@@ -290,7 +307,7 @@ void register_klein_gordon(tsi::Registry& registry) {
   // to h = 1/128 (order 0.90 over 1/16 .. 1/128, 1.74 over 1/64 .. 1/512).
   entry.verification = {{1.0, 1.0 / 256, 1e-4, 1e-6}, {16, 32, 64, 128}};
   entry.create = [](const tsi::Params& p) {
-    return std::make_unique<KleinGordon>(p.number("eps"), static_cast<int>(p.integer("n_x")), p.number("lambda"),
+    return std::make_unique<KleinGordon>(p.number("eps"), tsi::spectral_grid_shape(p), p.number("lambda"),
                                          p.context().fft);
   };
   registry.add_model(std::move(entry));

@@ -1,32 +1,41 @@
-// The cubic nonlinear Schroedinger equation on the torus (eq. NLS eq; SPEC.md section 4):
-//     i u_t = -(1/eps) u_xx + |u|^2 u,   x in [0, 2 pi) periodic,
-// discretised by the Fourier pseudospectral method with N_x points x_j = 2 pi j / N_x.
+// The cubic nonlinear Schroedinger equation on the torus (eq. NLS eq; SPEC.md sections 4, 7):
+//     i u_t = -(1/eps) lap u + |u|^2 u,   x in [0, 2 pi)^d periodic, d = 1, 2 or 3 (`dims`),
+// discretised by the Fourier pseudospectral method on tsi::SpectralGrid's N = n_x [x n_y [x n_z]]
+// points x = 2 pi (j_x / n_x, ..).
 //
-// State: the N_x Fourier coefficients c_m = sqrt(2 pi) * uhat_m of u(x) = sum_m uhat_m e^{i m x},
-// in FFT order (index k holds the wave number m = k for k < N_x/2, m = k - N_x above; the
-// Nyquist mode only enters through m^2). With this normalisation sum |c_m|^2 is the discrete
-// ||u||_{L2}^2 (Parseval), so the default mass <c, c> is SPEC's m, and
-//     J = -i/2,   M = 2 diag(m^2),   H1 = (1/2) ||u||_{L4}^4 = (pi/N_x) sum_j |u_j|^4
-// give I = (1/(2 eps)) <Mc, c> = (1/eps) ||u_x||_{L2}^2, (1/eps) J M c = -(i/eps) m^2 c (the
+// State: the N Fourier coefficients c_m = (2 pi)^{d/2} uhat_m of u(x) = sum_m uhat_m e^{i m.x},
+// in the grid's order (FFT order in each direction, C order across them; the Nyquist modes
+// only enter through m^2). With this normalisation sum |c_m|^2 is the discrete ||u||_{L2}^2
+// (Parseval), so the default mass <c, c> is SPEC's m, and
+//     J = -i/2,   M = 2 diag(|m|^2),   H1 = (1/2) ||u||_{L4}^4 = (1/2) ((2 pi)^d / N) sum_j |u_j|^4
+// give I = (1/(2 eps)) <Mc, c> = (1/eps) ||grad u||_{L2}^2, (1/eps) J M c = -(i/eps) |m|^2 c (the
 // linear part of the equation), and J grad H1 = -i |u|^2 u in physical space. The
 // semi-discrete system is Hamiltonian for exactly this H1, so H = I + H1 is its invariant.
 //
-// Physical variables are the samples u_j on the x grid: to_physical is the inverse transform,
-// from_physical the forward one, and errors are measured in the discrete L2 norm
-// sqrt(2 pi / N_x) |u|.
+// Physical variables are the samples u_j on the grid (an (n_x[, n_y[, n_z]]) array in C
+// order): to_physical is the inverse transform, from_physical the forward one, and errors are
+// measured in the discrete L2 norm sqrt((2 pi)^d / N) |u|.
+//
+// Initial data (`initial`): "paper", the paper's u0(x) = e^{ix} / (1 + sin^2 x) in 1-D and its
+// product over the directions in 2-D and 3-D (analytic and periodic, a sum of modes decaying
+// like e^{-0.88 |m_i|} in each direction); "plane-wave", u = a e^{i k.x} (`amplitude` a,
+// `wave_vector` k), whose exact solution a e^{i k.x} e^{-i (|k|^2/eps + a^2) t} the model
+// declares (a run's reference.scheme "exact").
 #include <cmath>
 #include <algorithm>
+#include <array>
 #include <complex>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "tsi/error.hpp"
-#include "tsi/grid_fft.hpp"
 #include "tsi/model.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/plugin.hpp"
+#include "tsi/spectral_grid.hpp"
 
 namespace {
 
@@ -36,61 +45,154 @@ using tsi::Index;
 using tsi::MatrixRef;
 using tsi::Vector;
 
+/// e^{-i m^2 tau_j} per direction: (n_i/2 + 1) x n_tau each (a small grid's, read in its steps).
+using PhaseTables = std::array<tsi::Matrix, 3>;
+
+// a b and a conj(b), written out: std::complex's operator* tests every product for inf/NaN.
+Complex times(Complex a, Complex b) {
+  return {a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real()};
+}
+Complex times_conj(Complex a, Complex b) {
+  return {a.real() * b.real() + a.imag() * b.imag(), a.imag() * b.real() - a.real() * b.imag()};
+}
+
+// e^{-i m^2 tau} for m = 1, 2, ... in turn, by phase_table's recurrence (the same products).
+class PhaseRecurrence {
+ public:
+  explicit PhaseRecurrence(double tau) : z_(std::polar(1.0, -tau)), z2_(z_ * z_), factor_(z_) {}
+  Complex next() {
+    phase_ *= factor_;
+    factor_ *= z2_;
+    return phase_;
+  }
+
+ private:
+  Complex z_, z2_, phase_ = 1.0, factor_;
+};
+
+// e^{-i m^2 tau_j} for m = 0 .. n/2 (rows) and every tau_j (columns), by the recurrence
+// e^{-i (m+1)^2 tau} = e^{-i m^2 tau} e^{-i (2m+1) tau}: one sincos per column, rounding of
+// a few m^2 ulp (as the rounding of m^2 tau itself).
+tsi::Matrix phase_table(const tsi::RealVector& taus, int n) {
+  tsi::Matrix phases(n / 2 + 1, taus.size());
+  for (Index j = 0; j < taus.size(); ++j) {
+    PhaseRecurrence recurrence(taus(j));
+    phases(0, j) = 1.0;
+    for (int m = 1; m <= n / 2; ++m) phases(m, j) = recurrence.next();
+  }
+  return phases;
+}
+
+// The phases e^{-i m_i^2 tau} of one tau, m_i = 0 .. n_i/2 per direction (from the tables
+// where given, else by the recurrence), and their products e^{-i |m|^2 tau} at every point.
+class Phases {
+ public:
+  explicit Phases(const tsi::SpectralGrid& grid) : grid_(grid) {
+    for (int i = 0; i < grid.dims(); ++i)
+      per_direction_[static_cast<std::size_t>(i)].resize(grid.shape()[static_cast<std::size_t>(i)] / 2 + 1);
+  }
+  void set(double tau, const PhaseTables* tables, Index column) {
+    for (int i = 0; i < grid_.dims(); ++i) {
+      Vector& phase = per_direction_[static_cast<std::size_t>(i)];
+      if (tables) {
+        phase = (*tables)[static_cast<std::size_t>(i)].col(column);
+        continue;
+      }
+      PhaseRecurrence recurrence(tau);
+      phase(0) = 1.0;
+      for (Index m = 1; m < phase.size(); ++m) phase(m) = recurrence.next();
+    }
+  }
+  // use(point, e^{-i |m|^2 tau}) in the grid's order. In 1-D the direction's phase itself
+  // (no product: the 1-D values of before the grid, to the bit).
+  template <class Use>
+  void for_each_point(Use&& use) const {
+    const std::vector<int>& last = grid_.folded(grid_.dims() - 1);
+    const Vector& last_phase = per_direction_[static_cast<std::size_t>(grid_.dims() - 1)];
+    const Index n_last = static_cast<Index>(last.size());
+    if (grid_.dims() == 1) {
+      for (Index q = 0; q < n_last; ++q) use(q, last_phase(last[static_cast<std::size_t>(q)]));
+      return;
+    }
+    const Index rows = grid_.points() / n_last;  // the leading directions' points
+    const int n2 = grid_.dims() == 3 ? grid_.shape()[1] : 1;
+    for (Index r = 0; r < rows; ++r) {
+      const Index a = r / n2, b = r % n2;
+      Complex lead = per_direction_[0](grid_.folded(0)[static_cast<std::size_t>(a)]);
+      if (grid_.dims() == 3) lead = times(lead, per_direction_[1](grid_.folded(1)[static_cast<std::size_t>(b)]));
+      for (Index q = 0; q < n_last; ++q) use(r * n_last + q, times(lead, last_phase(last[static_cast<std::size_t>(q)])));
+    }
+  }
+
+ private:
+  const tsi::SpectralGrid& grid_;
+  std::array<Vector, 3> per_direction_;
+};
+
+/// The initial data a user picks (`model.initial`).
+struct InitialData {
+  bool plane_wave = false;  // else the paper's u0 (its product over the directions)
+  double amplitude = 1.0;
+  std::array<int, 3> wave_vector{0, 0, 0};
+};
 
 class Nls final : public tsi::Model,
                   public tsi::HamiltonianStructure,
                   public tsi::FusedTauGrid,
                   public tsi::ExactNonlinearFlow,
-                  public tsi::PhysicalVariables {
+                  public tsi::PhysicalVariables,
+                  public tsi::ExactSolution {
  public:
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
-  Nls(double eps, int n_x, tsi::ThreadLimit fftw_threads = {})
-      : Model(eps), n_x_(n_x), wave_numbers_(n_x), batches_(n_x, fftw_threads) {
-    for (int k = 0; k < n_x; ++k) wave_numbers_(k) = 2 * k < n_x ? k : k - n_x;
+  Nls(double eps, std::vector<int> shape, InitialData initial, tsi::ThreadLimit fftw_threads = {})
+      : Model(eps),
+        grid_(std::move(shape)),
+        initial_(initial),
+        volume_(std::pow(tsi::two_pi, grid_.dims())),
+        batches_(grid_, fftw_threads) {
     batch(1);  // the single-state plans (filtered, direct, invariants)
   }
 
-  Index dim() const override { return n_x_; }
+  Index dim() const override { return grid_.points(); }
   bool is_complex() const override { return true; }
 
   const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
   const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
   const tsi::ExactNonlinearFlow* exact_nonlinear_flow() const override { return this; }
   const tsi::PhysicalVariables* physical_variables() const override { return this; }
+  const tsi::ExactSolution* exact_solution() const override { return initial_.plane_wave ? this : nullptr; }
 
-  // e^{JM tau}: mode m times e^{-i m^2 tau}.
+  // e^{JM tau}: mode m times e^{-i |m|^2 tau} = prod_i e^{-i m_i^2 tau}.
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
-    const tsi::Matrix phase = phase_table(taus, n_x_);
-    const int half = n_x_ / 2;
-    for (Index j = 0; j < u.cols(); ++j)
-      for (int m = 1; m <= half; ++m) {
-        u(m, j) *= phase(m, j);
-        if (n_x_ - m != m) u(n_x_ - m, j) *= phase(m, j);
-      }
+    Phases phases(grid_);
+    for (Index j = 0; j < u.cols(); ++j) {
+      phases.set(taus(j), nullptr, j);
+      phases.for_each_point([&](Index p, Complex e) { u(p, j) *= e; });
+    }
   }
 
   // -i |u|^2 u on the grid, in batched transforms each way (a slice of columns at a time).
-  // With w = backward(c) = sqrt(2 pi) u:  out = -i forward(|w|^2 w) / (2 pi N_x).
+  // With w = backward(c) = (2 pi)^{d/2} u:  out = -i forward(|w|^2 w) / ((2 pi)^d N).
   void nonlinear_field(ConstMatrixRef c, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridFft& b = batch(slice(c.cols()));
-    const Complex scale(0.0, -1.0 / (tsi::two_pi * n_x_));
+    tsi::GridTransforms& b = batch(slice(c.cols()));
+    const Complex scale(0.0, -1.0 / (volume_ * point_count()));
     for (Index j0 = 0; j0 < c.cols(); j0 += b.columns()) {
       const Index k = std::min(b.columns(), c.cols() - j0);
-      auto w = b.data();  // row j: state j0 + j
-      w.topRows(k) = c.middleCols(j0, k).transpose();
-      if (k < w.rows()) w.bottomRows(w.rows() - k).setZero();
+      auto w = b.data();  // column j: state j0 + j
+      w.leftCols(k) = c.middleCols(j0, k);
+      if (k < w.cols()) w.rightCols(w.cols() - k).setZero();
       b.backward();
-      for (Index i = 0; i < n_x_; ++i)
-        for (Index j = 0; j < w.rows(); ++j) w(j, i) *= scale * std::norm(w(j, i));
+      for (Index j = 0; j < w.cols(); ++j)
+        for (Index i = 0; i < w.rows(); ++i) w(i, j) *= scale * std::norm(w(i, j));
       b.forward();
-      out.middleCols(j0, k) = w.topRows(k).transpose();
+      out.middleCols(j0, k) = w.leftCols(k);
     }
   }
 
   void filtered_field(const tsi::RealVector& taus, MatrixRef c, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    fused_field(taus, nullptr, batch(slice(c.cols())), c, out);
+    fused_field(taus, nullptr, phases_, batch(slice(c.cols())), c, out);
   }
 
   // A run's tau grid: its phases, and transforms of its own for a slice of the grid's columns
@@ -99,14 +201,20 @@ class Nls final : public tsi::Model,
   class GridField final : public tsi::TauGridField {
    public:
     GridField(const Nls& model, const tsi::RealVector& taus)
-        : model_(model), taus_(taus), batch_(model.n_x_, model.slice(taus.size()), model.batches_.fftw_threads()) {
-      // A small grid keeps its phases in a table (read, not recomputed: 15% of a step at
-      // n_x = 16, n_tau = 256); a large one computes them as it goes (no table of half the
-      // state's size).
-      if ((model.n_x_ / 2 + 1) * taus.size() <= max_phase_table) phase_ = phase_table(taus, model.n_x_);
+        : model_(model),
+          taus_(taus),
+          phases_(model.grid_),
+          batch_(model.grid_, model.slice(taus.size()), model.batches_.fftw_threads()) {
+      // A small grid keeps its phases in tables (read, not recomputed: 15% of a step at
+      // n_x = 16, n_tau = 256); a large one computes them as it goes.
+      Index size = 0;
+      for (const int n : model.grid_.shape()) size += (n / 2 + 1) * taus.size();
+      if (size <= max_phase_table)
+        for (int i = 0; i < model.grid_.dims(); ++i)
+          tables_[static_cast<std::size_t>(i)] = phase_table(taus, model.grid_.shape()[static_cast<std::size_t>(i)]);
     }
     void evaluate(MatrixRef c, MatrixRef out) override {
-      model_.fused_field(taus_, phase_.size() ? &phase_ : nullptr, batch_, c, out);
+      model_.fused_field(taus_, tables_[0].size() ? &tables_ : nullptr, phases_, batch_, c, out);
     }
     bool in_place() const override { return true; }
 
@@ -114,8 +222,9 @@ class Nls final : public tsi::Model,
     static constexpr Index max_phase_table = Index{1} << 15;  // 512 kB
     const Nls& model_;
     tsi::RealVector taus_;
-    tsi::Matrix phase_;
-    tsi::GridFft batch_;
+    PhaseTables tables_;
+    Phases phases_;
+    tsi::GridTransforms batch_;
   };
 
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
@@ -124,54 +233,34 @@ class Nls final : public tsi::Model,
   // Each binding owns its tables and transforms: bindings may run on different threads.
   bool independent_tau_grid_bindings() const override { return true; }
 
-  // f_tau in one pass each way: the phases e^{-i m^2 tau} are applied while the states are
-  // copied (transposed) into the x-batch, and their conjugates (the flow at -tau) while the
-  // result is copied out; the cubic term is written out in real arithmetic (-i a w = (a im, -a re)).
-  // The phases come from phase_table's recurrence, column by column as they are needed (the
-  // same products: no table of the state's half size). A slice of b.columns() columns at a
-  // time, each read before it is written: out may be c.
-  // use(m, e^{-i m^2 tau}) for m = 1 .. N_x/2: from column `col` of `phase` (phase_table's
-  // values) where there is one, else by the recurrence (no sincos per column with a table).
-  template <class Use>
-  void for_each_phase(double tau, const tsi::Matrix* phase, Index col, Use&& use) const {
-    const int half = n_x_ / 2;
-    if (phase) {
-      for (int m = 1; m <= half; ++m) use(m, (*phase)(m, col));
-      return;
-    }
-    PhaseRecurrence recurrence(tau);
-    for (int m = 1; m <= half; ++m) use(m, recurrence.next());
-  }
-
-  // With `phase` (phase_table's values for taus), the phases are read from it instead.
-  void fused_field(const tsi::RealVector& taus, const tsi::Matrix* phase, tsi::GridFft& b, MatrixRef c,
-                   MatrixRef out) const {
-    const double scale = 1.0 / (tsi::two_pi * n_x_);
+  // f_tau in one pass each way: the phases e^{-i |m|^2 tau} are applied while the states are
+  // copied into the batch, and their conjugates (the flow at -tau) while the result is copied
+  // out; the cubic term is written out in real arithmetic (-i a w = (a im, -a re)). The phases
+  // come from phase_table's recurrence per direction (the same products as its table: with
+  // `tables`, its values are read). A slice of b.columns() columns at a time, each read before
+  // it is written: out may be c.
+  void fused_field(const tsi::RealVector& taus, const PhaseTables* tables, Phases& phases, tsi::GridTransforms& b,
+                   MatrixRef c, MatrixRef out) const {
+    const double scale = 1.0 / (volume_ * point_count());
     for (Index j0 = 0; j0 < c.cols(); j0 += b.columns()) {
       const Index k = std::min(b.columns(), c.cols() - j0);
-      auto w = b.data();  // row j: state j0 + j
+      auto w = b.data();  // column j: state j0 + j
       for (Index j = 0; j < k; ++j) {
-        w(j, 0) = c(0, j0 + j);
-        for_each_phase(taus(j0 + j), phase, j0 + j, [&](int m, Complex e) {
-          w(j, m) = times(c(m, j0 + j), e);
-          if (n_x_ - m != m) w(j, n_x_ - m) = times(c(n_x_ - m, j0 + j), e);
-        });
+        phases.set(taus(j0 + j), tables, j0 + j);
+        phases.for_each_point([&](Index p, Complex e) { w(p, j) = times(c(p, j0 + j), e); });
       }
-      if (k < w.rows()) w.bottomRows(w.rows() - k).setZero();
+      if (k < w.cols()) w.rightCols(w.cols() - k).setZero();
       b.backward();
-      double* p = reinterpret_cast<double*>(w.data());
+      double* q = reinterpret_cast<double*>(w.data());
       for (Index i = 0; i < 2 * w.size(); i += 2) {
-        const double re = p[i], im = p[i + 1], a = scale * (re * re + im * im);
-        p[i] = a * im;
-        p[i + 1] = -a * re;
+        const double re = q[i], im = q[i + 1], a = scale * (re * re + im * im);
+        q[i] = a * im;
+        q[i + 1] = -a * re;
       }
       b.forward();
       for (Index j = 0; j < k; ++j) {
-        out(0, j0 + j) = w(j, 0);
-        for_each_phase(taus(j0 + j), phase, j0 + j, [&](int m, Complex e) {
-          out(m, j0 + j) = times_conj(w(j, m), e);
-          if (n_x_ - m != m) out(n_x_ - m, j0 + j) = times_conj(w(j, n_x_ - m), e);
-        });
+        phases.set(taus(j0 + j), tables, j0 + j);
+        phases.for_each_point([&](Index p, Complex e) { out(p, j0 + j) = times_conj(w(p, j), e); });
       }
     }
   }
@@ -181,200 +270,250 @@ class Nls final : public tsi::Model,
     std::lock_guard<std::mutex> lock(mutex_);
     // A large batch (the prepared data's, a run's tau grid) gets transforms of its own for this
     // call, freed after it: the derivative is not needed while the run steps.
-    std::unique_ptr<tsi::GridFft> own;
-    if (slice(c.cols()) < c.cols()) own = std::make_unique<tsi::GridFft>(n_x_, slice(c.cols()), batches_.fftw_threads());
-    tsi::GridFft& b = own ? *own : batch(c.cols());
+    std::unique_ptr<tsi::GridTransforms> own;
+    if (slice(c.cols()) < c.cols())
+      own = std::make_unique<tsi::GridTransforms>(grid_, slice(c.cols()), batches_.fftw_threads());
+    tsi::GridTransforms& b = own ? *own : batch(c.cols());
     tsi::Matrix& grid = b.scratch();
-    const Complex scale(0.0, -1.0 / (tsi::two_pi * n_x_));
+    const Complex scale(0.0, -1.0 / (volume_ * point_count()));
     for (Index j0 = 0; j0 < c.cols(); j0 += b.columns()) {
       const Index k = std::min(b.columns(), c.cols() - j0);
-      auto w = b.data();  // row j: state j0 + j
-      w.topRows(k) = c.middleCols(j0, k).transpose();
-      if (k < w.rows()) w.bottomRows(w.rows() - k).setZero();
+      auto w = b.data();  // column j: state j0 + j
+      w.leftCols(k) = c.middleCols(j0, k);
+      if (k < w.cols()) w.rightCols(w.cols() - k).setZero();
       b.backward();
       grid = w;
-      w.topRows(k) = dc.middleCols(j0, k).transpose();
+      w.leftCols(k) = dc.middleCols(j0, k);
       b.backward();
-      for (Index i = 0; i < n_x_; ++i)
-        for (Index j = 0; j < w.rows(); ++j) {
-          const Complex g = grid(j, i), z = w(j, i);
-          w(j, i) = scale * (2.0 * std::norm(g) * z + g * g * std::conj(z));
+      for (Index j = 0; j < w.cols(); ++j)
+        for (Index i = 0; i < w.rows(); ++i) {
+          const Complex g = grid(i, j), z = w(i, j);
+          w(i, j) = scale * (2.0 * std::norm(g) * z + g * g * std::conj(z));
         }
       b.forward();
-      out.middleCols(j0, k) = w.topRows(k).transpose();
+      out.middleCols(j0, k) = w.leftCols(k);
     }
   }
 
   void apply_M(const Vector& u, Vector& out) const override {
-    out.resize(n_x_);
-    for (Index k = 0; k < n_x_; ++k) out(k) = 2.0 * wave_numbers_(k) * wave_numbers_(k) * u(k);
+    out = 2.0 * grid_.laplacian_symbol().cwiseProduct(u);
   }
 
   void apply_J(const Vector& u, Vector& out) const override { out = Complex(0.0, -0.5) * u; }
 
-  // (1/2) ||u||_{L4}^4 = (pi / N_x) sum |u_j|^4 = sum |w_j|^4 / (4 pi N_x).
+  // (1/2) ||u||_{L4}^4 = (1/2) ((2 pi)^d / N) sum |u_j|^4 = sum |w_j|^4 / (2 (2 pi)^d N).
   double H1(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridFft& b = batch(1);
+    tsi::GridTransforms& b = batch(1);
     auto w = b.data();
-    w.row(0) = c.transpose();
+    w.col(0) = c;
     b.backward();
-    return w.row(0).cwiseAbs2().squaredNorm() / (2.0 * tsi::two_pi * n_x_);
+    return w.col(0).cwiseAbs2().squaredNorm() / (2.0 * volume_ * point_count());
   }
 
-  // The momentum P = sum_m m |c_m|^2 = 2 pi sum_m m |uhat_m|^2 = -i <u, u_x> = Im int conj(u) u_x dx
-  // (P = ||u||^2 for u = e^{ix}), the Nyquist mode weighted 0 as the spectral derivative weights it.
-  // The NLS flow conserves it (translation invariance); the collocated |u|^2 u does not quite: the
-  // semi-discrete system is invariant under translations by whole grid steps only, and P changes
-  // by the aliasing of the cubic term. Measured with rk78 (tol 1e-13) on the direct problem from
-  // the paper's u0 (whose modes are odd, so the Nyquist mode stays 0): relative change 2.9e-5 ..
-  // 3.7e-5 over t = 1 (eps = 0.01 .. 1) and 2.3e-4 over t = 10 at n_x = 16, 7.8e-10 over t = 10
-  // at n_x = 32, and from n_x = 64 no more than H changes (1e-15 .. 4e-14 over t = 1: the
-  // rounding of rk78's steps).
-  double momentum(const Vector& c) const {
+  // The momentum along direction i, P_i = sum_m m_i |c_m|^2 = Im int conj(u) d_i u dx
+  // (P = ||u||^2 for u = e^{ix}), the Nyquist modes weighted 0 as the spectral derivative weights
+  // them. The NLS flow conserves it (translation invariance); the collocated |u|^2 u does not
+  // quite: the semi-discrete system is invariant under translations by whole grid steps only,
+  // and P changes by the aliasing of the cubic term. Measured with rk78 (tol 1e-13) on the direct
+  // problem from the paper's 1-D u0 (whose modes are odd, so the Nyquist mode stays 0): relative
+  // change 2.9e-5 .. 3.7e-5 over t = 1 (eps = 0.01 .. 1) and 2.3e-4 over t = 10 at n_x = 16,
+  // 7.8e-10 over t = 10 at n_x = 32, and from n_x = 64 no more than H changes (1e-15 .. 4e-14
+  // over t = 1: the rounding of rk78's steps).
+  double momentum(int direction, const Vector& c) const {
+    const int n = grid_.shape()[static_cast<std::size_t>(direction)];
+    Index stride = 1;  // C order: the last direction's index runs fastest
+    for (int i = direction + 1; i < grid_.dims(); ++i) stride *= grid_.shape()[static_cast<std::size_t>(i)];
     double p = 0.0;
-    for (Index k = 0; k < n_x_; ++k)
-      if (2 * k != n_x_) p += wave_numbers_(k) * std::norm(c(k));
+    for (Index q = 0; q < c.size(); ++q) {
+      const int j = static_cast<int>((q / stride) % n);
+      if (2 * j != n) p += grid_.wave_number(direction, j) * std::norm(c(q));
+    }
     return p;
   }
 
   std::vector<tsi::ModelInvariant> invariants() const override {
-    return {{"P",
-             "momentum sum_m m |c_m|^2 = Im int conj(u) u_x dx; exact for NLS, kept by the Fourier "
-             "collocation up to aliasing (relative 4e-5 over t = 1 at n_x = 16, rounding at n_x = 64)",
-             [this](const Vector& c) { return momentum(c); }}};
+    const std::string what =
+        "; exact for NLS, kept by the Fourier collocation up to aliasing (relative 4e-5 over t = 1 at n_x = 16 in "
+        "1-D, rounding at n_x = 64)";
+    if (grid_.dims() == 1)
+      return {{"P", "momentum sum_m m |c_m|^2 = Im int conj(u) u_x dx" + what,
+               [this](const Vector& c) { return momentum(0, c); }}};
+    std::vector<tsi::ModelInvariant> all;
+    const char* axes = "xyz";
+    for (int i = 0; i < grid_.dims(); ++i) {
+      const std::string axis(1, axes[i]);
+      all.push_back({"P_" + axis, "momentum sum_m m_" + axis + " |c_m|^2 = Im int conj(u) u_" + axis + " dx" + what,
+                     [this, i](const Vector& c) { return momentum(i, c); }});
+    }
+    return all;
   }
 
-  // The fastest mode, m = N_x/2, turns with e^{-i (N_x/2)^2 tau}.
-  double max_linear_frequency() const override { return 0.25 * n_x_ * n_x_; }
+  // The fastest mode turns with e^{-i |m|^2 tau}, |m|^2 = sum (n_i/2)^2.
+  double max_linear_frequency() const override { return grid_.max_laplacian_symbol(); }
 
   // u' = -i |u|^2 u keeps |u| fixed pointwise: u -> u e^{-i |u|^2 t} on the grid.
   void nonlinear_flow(double t, Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridFft& b = batch(1);
+    tsi::GridTransforms& b = batch(1);
     auto w = b.data();
-    w.row(0) = c.transpose();
+    w.col(0) = c;
     b.backward();
-    const double to_u2 = 1.0 / tsi::two_pi;  // |u|^2 = |w|^2 / (2 pi)
-    for (Index i = 0; i < n_x_; ++i) w(0, i) *= std::polar(1.0 / n_x_, -t * std::norm(w(0, i)) * to_u2);
+    const double to_u2 = 1.0 / volume_;  // |u|^2 = |w|^2 / (2 pi)^d
+    const double points = static_cast<double>(grid_.points());
+    for (Index i = 0; i < w.rows(); ++i) w(i, 0) *= std::polar(1.0 / points, -t * std::norm(w(i, 0)) * to_u2);
     b.forward();
-    c = w.row(0).transpose();
+    c = w.col(0);
   }
 
-  // u0(x) = (cos x + i sin x) / (1 + sin^2 x) (the paper's).
   Vector initial_value() const override {
-    Vector x(n_x_);
-    for (Index j = 0; j < n_x_; ++j) {
-      const double xj = tsi::two_pi * static_cast<double>(j) / n_x_, s = std::sin(xj);
-      x(j) = std::polar(1.0, xj) / (1.0 + s * s);
-    }
+    Vector x(grid_.points());
+    grid_.for_each_point([&](Index p, const std::array<double, 3>& at) {
+      if (initial_.plane_wave) {
+        double phase = 0.0;
+        for (int i = 0; i < grid_.dims(); ++i)
+          phase += initial_.wave_vector[static_cast<std::size_t>(i)] * at[static_cast<std::size_t>(i)];
+        x(p) = std::polar(initial_.amplitude, phase);
+        return;
+      }
+      // the paper's e^{ix} / (1 + sin^2 x), a factor per direction
+      Complex value = paper_profile(at[0]);
+      for (int i = 1; i < grid_.dims(); ++i) value *= paper_profile(at[static_cast<std::size_t>(i)]);
+      x(p) = value;
+    });
     return from_physical(x);
   }
 
-  Index physical_dim() const override { return n_x_; }
-
-  // Grid samples -> c = sqrt(2 pi) / N_x * forward(samples).
-  Vector from_physical(const Vector& x) const override {
-    if (x.size() != n_x_)
-      throw tsi::ConfigError(
-          "model.u0", "got " + std::to_string(x.size()) + " samples, expected n_x = " + std::to_string(n_x_));
-    std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridFft& b = batch(1);
-    auto w = b.data();
-    w.row(0) = x.transpose();
-    b.forward();
-    return w.row(0).transpose() * (std::sqrt(tsi::two_pi) / n_x_);
+  // The plane wave a e^{i k.x} e^{-i (|k|^2/eps + a^2) t}: x0 times the phase, where x0 is that
+  // wave (a run from another model.u0 has no exact solution: an error names it).
+  tsi::ExactSolution::Value at(const Vector& x0, double t) const override {
+    const Vector wave = to_physical(initial_value());
+    if ((x0 - wave).norm() > 1e-13 * std::max(1.0, wave.norm()))
+      throw tsi::Error("nls: the exact solution is the plane wave of model.initial = \"plane-wave\"; this run "
+                       "starts elsewhere (model.u0 given)");
+    double k2 = 0.0;
+    for (int i = 0; i < grid_.dims(); ++i)
+      k2 += static_cast<double>(initial_.wave_vector[static_cast<std::size_t>(i)]) *
+            initial_.wave_vector[static_cast<std::size_t>(i)];
+    const double frequency = k2 / eps() + initial_.amplitude * initial_.amplitude;
+    // The phase is rounded to a few ulp of frequency * t, as the schemes' own e^{-i |m|^2 t / eps}.
+    const double rounding = std::numeric_limits<double>::epsilon();
+    return {x0 * std::polar(1.0, -frequency * t), std::max(rounding, 4.0 * rounding * std::abs(frequency * t))};
   }
 
-  // c -> grid samples u_j = backward(c)_j / sqrt(2 pi).
+  Index physical_dim() const override { return grid_.points(); }
+  std::vector<Index> physical_shape() const override { return {grid_.shape().begin(), grid_.shape().end()}; }
+
+  // Grid samples -> c = (2 pi)^{d/2} / N * forward(samples).
+  Vector from_physical(const Vector& x) const override {
+    if (x.size() != grid_.points())
+      throw tsi::ConfigError("model.u0", "got " + std::to_string(x.size()) + " samples, expected " +
+                                             std::to_string(grid_.points()) + " (the grid " + grid_.describe() + ")");
+    std::lock_guard<std::mutex> lock(mutex_);
+    tsi::GridTransforms& b = batch(1);
+    auto w = b.data();
+    w.col(0) = x;
+    b.forward();
+    return w.col(0) * (std::sqrt(volume_) / static_cast<double>(grid_.points()));
+  }
+
+  // c -> grid samples u_j = backward(c)_j / (2 pi)^{d/2}.
   Vector to_physical(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridFft& b = batch(1);
+    tsi::GridTransforms& b = batch(1);
     auto w = b.data();
-    w.row(0) = c.transpose();
+    w.col(0) = c;
     b.backward();
-    return w.row(0).transpose() / std::sqrt(tsi::two_pi);
+    return w.col(0) / std::sqrt(volume_);
   }
 
   // Discrete L2 norm of grid samples.
-  double error_norm(const Vector& x) const override { return std::sqrt(tsi::two_pi / n_x_) * x.norm(); }
+  double error_norm(const Vector& x) const override {
+    return std::sqrt(volume_ / static_cast<double>(grid_.points())) * x.norm();
+  }
 
  private:
   // The transforms for batches of `columns` states, planned on first use and kept: a run
   // sees two or three batch sizes (1 and N_tau), so nothing is planned inside a step after
   // the first call. Callers hold mutex_.
-  tsi::GridFft& batch(Index columns) const { return batches_.get(columns); }
+  tsi::GridTransforms& batch(Index columns) const { return batches_.get(columns); }
 
   // Columns a batched call transforms at once: a large batch (a run's tau grid) goes through
-  // the x transforms a slice at a time, so the model's work space is a slice of the state.
+  // the transforms a slice at a time, so the model's work space is a slice of the state.
   static constexpr Index slice_columns = 32;
   Index slice(Index columns) const {
-    return static_cast<Index>(n_x_) * columns >= (Index{1} << 16) ? std::min(columns, slice_columns) : columns;
+    return grid_.points() * columns >= (Index{1} << 16) ? std::min(columns, slice_columns) : columns;
   }
 
-  // e^{-i m^2 tau} for m = 1, 2, ... in turn, by phase_table's recurrence (the same products).
-  class PhaseRecurrence {
-   public:
-    explicit PhaseRecurrence(double tau) : z_(std::polar(1.0, -tau)), z2_(z_ * z_), factor_(z_) {}
-    Complex next() {
-      phase_ *= factor_;
-      factor_ *= z2_;
-      return phase_;
-    }
+  double point_count() const { return static_cast<double>(grid_.points()); }
 
-   private:
-    Complex z_, z2_, phase_ = 1.0, factor_;
-  };
-
-  // e^{-i m^2 tau_j} for m = 0 .. N_x/2 (rows) and every tau_j (columns), by the recurrence
-  // e^{-i (m+1)^2 tau} = e^{-i m^2 tau} e^{-i (2m+1) tau}: one sincos per column, rounding of
-  // a few m^2 ulp (as the rounding of m^2 tau itself).
-  static tsi::Matrix phase_table(const tsi::RealVector& taus, int n_x) {
-    tsi::Matrix phases(n_x / 2 + 1, taus.size());
-    for (Index j = 0; j < taus.size(); ++j) {
-      const Complex z = std::polar(1.0, -taus(j)), z2 = z * z;
-      Complex phase = 1.0, factor = z;  // e^{-i m^2 tau}, e^{-i (2m+1) tau}
-      phases(0, j) = 1.0;
-      for (int m = 1; m <= n_x / 2; ++m) {
-        phase *= factor;
-        factor *= z2;
-        phases(m, j) = phase;
-      }
-    }
-    return phases;
+  static Complex paper_profile(double x) {
+    const double s = std::sin(x);
+    return std::polar(1.0, x) / (1.0 + s * s);
   }
 
-  // a b and a conj(b), written out: std::complex's operator* tests every product for inf/NaN.
-  static Complex times(Complex a, Complex b) {
-    return {a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real()};
-  }
-  static Complex times_conj(Complex a, Complex b) {
-    return {a.real() * b.real() + a.imag() * b.imag(), a.imag() * b.real() - a.real() * b.imag()};
-  }
-
-  int n_x_;
-  tsi::RealVector wave_numbers_;
-  mutable std::mutex mutex_;  // the batches' buffers are shared work space
-  mutable tsi::GridFftPool batches_;
+  tsi::SpectralGrid grid_;
+  InitialData initial_;
+  double volume_;              // (2 pi)^d
+  mutable std::mutex mutex_;   // the batches' buffers and phases_ are shared work space
+  mutable tsi::GridTransformsPool batches_;
+  mutable Phases phases_{grid_};
 };
+
+InitialData initial_data(const tsi::Params& p, const std::vector<int>& shape) {
+  InitialData data;
+  data.plane_wave = p.string("initial") == "plane-wave";
+  const int dims = static_cast<int>(shape.size());
+  if (!data.plane_wave) {
+    for (const char* key : {"wave_vector", "amplitude"})
+      if (p.has(key))
+        throw tsi::ConfigError(std::string("model.") + key, "is given, but model.initial is \"" + p.string("initial") +
+                                                                "\" (it belongs to \"plane-wave\")");
+    return data;
+  }
+  if (p.has("amplitude")) data.amplitude = p.number("amplitude");
+  data.wave_vector[0] = 1;  // the default: e^{ix}
+  if (!p.has("wave_vector")) return data;
+  const tsi::Json& k = p.raw().at("wave_vector");
+  if (static_cast<int>(k.size()) != dims)
+    throw tsi::ConfigError("model.wave_vector", "got " + k.dump() + ", expected " + std::to_string(dims) +
+                                                    " integers (one per direction, dims = " + std::to_string(dims) + ")");
+  for (int i = 0; i < dims; ++i) {
+    const tsi::Json& v = k.at(static_cast<std::size_t>(i));
+    const int n = shape[static_cast<std::size_t>(i)];
+    // Resolved on the grid: |k_i| < n_i / 2 (the Nyquist mode has no sign).
+    if (!v.is_number_integer() || std::abs(v.get<long>()) >= n / 2)
+      throw tsi::ConfigError("model.wave_vector[" + std::to_string(i) + "]",
+                             "got " + v.dump() + ", expected an integer of magnitude below n/2 = " + std::to_string(n / 2));
+    data.wave_vector[static_cast<std::size_t>(i)] = static_cast<int>(v.get<long>());
+  }
+  return data;
+}
 
 void register_nls(tsi::Registry& registry) {
   tsi::ModelEntry entry;
   entry.info.name = "nls";
   entry.info.summary =
-      "cubic NLS i u_t = -(1/eps) u_xx + |u|^2 u on the torus (eq. NLS eq), Fourier in x, dim n_x";
-  entry.info.params = {
-      tsi::integer_param("n_x", 16, "Fourier modes (grid points) in x; u0 is given as samples on this grid")
-          .check(
-              [](const tsi::Json& v) {
-                return v.get<long>() >= 2 && v.get<long>() <= (1L << 20) && v.get<long>() % 2 == 0;
-              },
-              "an even integer in [2, 1048576]")};
+      "cubic NLS i u_t = -(1/eps) lap u + |u|^2 u on the torus [0, 2 pi)^dims (eq. NLS eq), Fourier in space, "
+      "dim n_x [n_y [n_z]]";
+  entry.info.params = tsi::spectral_grid_params("samples of u");
+  entry.info.params.push_back(
+      tsi::string_param("initial", "paper",
+                        "initial data: \"paper\" (e^{ix} / (1 + sin^2 x), its product over the directions) or "
+                        "\"plane-wave\" (amplitude e^{i k.x}, with an exact solution)")
+          .choices({"paper", "plane-wave"}));
+  entry.info.params.push_back(
+      tsi::array_param("wave_vector", "the plane wave's k, one integer per direction with |k_i| < n_i/2; default (1, 0, 0)"));
+  entry.info.params.push_back(
+      tsi::number_param("amplitude", nullptr, "the plane wave's amplitude a; default 1")
+          .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number"));
   entry.default_n_tau = 256;
   entry.nonlinearity_degree = 3;
   entry.verification = {{1.0, 1.0 / 16, 1.0 / 256}, {4, 8, 16, 32}};
   entry.create = [](const tsi::Params& p) {
-    return std::make_unique<Nls>(p.number("eps"), static_cast<int>(p.integer("n_x")), p.context().fft);
+    std::vector<int> shape = tsi::spectral_grid_shape(p);
+    const InitialData initial = initial_data(p, shape);
+    return std::make_unique<Nls>(p.number("eps"), std::move(shape), initial, p.context().fft);
   };
   registry.add_model(std::move(entry));
 }

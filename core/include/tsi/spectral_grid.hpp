@@ -1,0 +1,124 @@
+#pragma once
+#include <array>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "tsi/context.hpp"
+#include "tsi/export.hpp"
+#include "tsi/params.hpp"
+#include "tsi/types.hpp"
+
+namespace tsi {
+
+/// The periodic grid of a pseudo-spectral model in 1, 2 or 3 dimensions: n_1 x .. x n_d points
+/// on [0, 2 pi)^d, x = 2 pi (j_1 / n_1, .., j_d / n_d), each n_i even. A field on it is a
+/// vector of points() values in C order (the last direction fastest: point (j_1, .., j_d) at
+/// (j_1 n_2 + j_2) n_3 + j_3), as NumPy stores an (n_1, .., n_d) array; its Fourier
+/// coefficients are stored the same way, index j along direction i holding the wave number
+/// j for j < n_i/2 and j - n_i above (FFTW's order; the Nyquist index n_i/2 enters only through
+/// m^2, as +-n_i/2). The geometry only: the transforms are GridTransforms.
+class TSI_API SpectralGrid {
+ public:
+  /// `shape`: 1 to 3 even sizes, each at least 2 (a tsi::Error naming the direction otherwise).
+  explicit SpectralGrid(std::vector<int> shape);
+
+  int dims() const { return static_cast<int>(shape_.size()); }
+  const std::vector<int>& shape() const { return shape_; }
+  /// n_1 x .. x n_d.
+  Index points() const { return points_; }
+  /// The wave number of index j along direction i: j < n_i/2 ? j : j - n_i.
+  int wave_number(int direction, int j) const;
+  /// |m| along direction i at index j: min(j, n_i - j), 0 .. n_i/2 (the index into a table of
+  /// anything that depends on m_i^2, as a phase e^{-i m_i^2 tau}).
+  const std::vector<int>& folded(int direction) const { return folded_[static_cast<std::size_t>(direction)]; }
+  /// |m|^2 = m_1^2 + .. + m_d^2 at every point, in the coefficients' order (the symbol of -lap).
+  const RealVector& laplacian_symbol() const { return laplacian_; }
+  /// The largest |m|^2, sum of (n_i/2)^2.
+  double max_laplacian_symbol() const;
+  /// The 2/3 rule's mask: 1 where every |m_i| <= n_i / 3, 0 elsewhere.
+  RealVector dealias_mask() const;
+  /// x_i at index j: 2 pi j / n_i.
+  double coordinate(int direction, int j) const;
+  /// Calls point(index, x) for every point in C order, x the point's coordinates (x_1 .. x_d).
+  template <class Point>
+  void for_each_point(Point&& point) const {
+    std::array<int, 3> j{0, 0, 0};
+    std::array<double, 3> x{0.0, 0.0, 0.0};
+    for (Index p = 0; p < points_; ++p) {
+      for (int i = 0; i < dims(); ++i) x[static_cast<std::size_t>(i)] = coordinate(i, j[static_cast<std::size_t>(i)]);
+      point(p, x);
+      for (int i = dims() - 1; i >= 0; --i) {  // the next index, the last direction fastest
+        if (++j[static_cast<std::size_t>(i)] < shape_[static_cast<std::size_t>(i)]) break;
+        j[static_cast<std::size_t>(i)] = 0;
+      }
+    }
+  }
+  /// "16", "256 x 256", "64 x 64 x 64".
+  std::string describe() const;
+
+ private:
+  std::vector<int> shape_;
+  Index points_ = 1;
+  std::vector<std::vector<int>> folded_;
+  RealVector laplacian_;
+};
+
+/// Batched transforms of `columns` fields on a SpectralGrid, each way: a points x columns
+/// buffer, field j in column j (contiguous), one d-dimensional FFTW plan each way over the
+/// whole batch. Sign convention FFTW's: forward is sum_x a(x) e^{-i m.x}, backward
+/// sum_m a_m e^{+i m.x}, neither normalised, so backward(forward(a)) = points() a. Owns its
+/// plans and buffer: a model binding its tau grid makes one of its own (no locks between
+/// bindings); not synchronised itself.
+class TSI_API GridTransforms {
+ public:
+  /// `fftw_threads`: FFTW's own threads for the batch (the run's Context::fft).
+  GridTransforms(const SpectralGrid& grid, Index columns, ThreadLimit fftw_threads = {});
+  ~GridTransforms();
+  GridTransforms(const GridTransforms&) = delete;
+  GridTransforms& operator=(const GridTransforms&) = delete;
+
+  /// points x columns: column j is field j (grid values or Fourier coefficients).
+  Eigen::Map<Matrix> data() { return Eigen::Map<Matrix>(buffer_, points_, columns_); }
+  /// Unnormalised: sum_x a(x) e^{-i m.x}.
+  void forward();
+  /// Unnormalised: sum_m a_m e^{+i m.x}.
+  void backward();
+  /// Work space of the same shape (a second grid, as a derivative needs), allocated on first use.
+  Matrix& scratch();
+  /// Fields it transforms at once.
+  Index columns() const { return columns_; }
+
+ private:
+  Index points_, columns_;
+  Complex* buffer_ = nullptr;
+  void* plans_[2] = {nullptr, nullptr};  // forward, backward
+  Matrix scratch_;
+};
+
+/// GridTransforms for every batch size a model meets, planned on first use and kept: a run sees
+/// two or three sizes (1 and n_tau, or a slice of n_tau), so nothing is planned inside a step
+/// after the first call. Not synchronised: the model serialises its calls (the buffers are
+/// shared work space).
+class TSI_API GridTransformsPool {
+ public:
+  GridTransformsPool(const SpectralGrid& grid, ThreadLimit fftw_threads = {}) : grid_(grid), fftw_threads_(fftw_threads) {}
+  GridTransforms& get(Index columns);
+  ThreadLimit fftw_threads() const { return fftw_threads_; }
+
+ private:
+  const SpectralGrid& grid_;
+  ThreadLimit fftw_threads_;
+  std::map<Index, std::unique_ptr<GridTransforms>> batches_;
+};
+
+/// The parameters of a model on a SpectralGrid: `dims` (1, 2 or 3, default 1) and the points
+/// per direction `n_x`, `n_y`, `n_z` (even, 2 .. 2^20; n_y and n_z default to n_x). `what`
+/// says what a value on the grid is, for the documentation ("samples of u").
+TSI_API ParamSchema spectral_grid_params(const std::string& what);
+/// The grid's shape from a model's resolved parameters: a ConfigError naming `model.n_y` or
+/// `model.n_z` where one is given beyond `dims`, or where the grid has more than 2^31 - 1 points.
+TSI_API std::vector<int> spectral_grid_shape(const Params& params);
+
+}  // namespace tsi

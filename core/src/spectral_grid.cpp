@@ -1,0 +1,174 @@
+#include "tsi/spectral_grid.hpp"
+
+#include <fftw3.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <limits>
+
+#include "fftw_planner.hpp"
+#include "tsi/error.hpp"
+#include "tsi/phase.hpp"
+
+namespace tsi {
+
+SpectralGrid::SpectralGrid(std::vector<int> shape) : shape_(std::move(shape)) {
+  if (shape_.empty() || shape_.size() > 3)
+    throw Error(fmt::format("SpectralGrid: {} directions given, expected 1, 2 or 3", shape_.size()));
+  for (std::size_t i = 0; i < shape_.size(); ++i) {
+    const int n = shape_[i];
+    if (n < 2 || n % 2 != 0)
+      throw Error(fmt::format("SpectralGrid: direction {} has {} points, expected an even number of at least 2", i + 1, n));
+    if (points_ > std::numeric_limits<int>::max() / n)  // FFTW's plans count points in int
+      throw Error(fmt::format("SpectralGrid: {} points exceed 2^31 - 1", describe()));
+    points_ *= n;
+    std::vector<int> folded(static_cast<std::size_t>(n));
+    for (int j = 0; j < n; ++j) folded[static_cast<std::size_t>(j)] = std::min(j, n - j);
+    folded_.push_back(std::move(folded));
+  }
+  laplacian_.resize(points_);
+  // C order: the index of the last direction runs fastest.
+  Index p = 0;
+  const int n1 = shape_[0], n2 = dims() > 1 ? shape_[1] : 1, n3 = dims() > 2 ? shape_[2] : 1;
+  for (int a = 0; a < n1; ++a)
+    for (int b = 0; b < n2; ++b)
+      for (int c = 0; c < n3; ++c, ++p) {
+        const double m1 = folded_[0][static_cast<std::size_t>(a)];
+        const double m2 = dims() > 1 ? folded_[1][static_cast<std::size_t>(b)] : 0.0;
+        const double m3 = dims() > 2 ? folded_[2][static_cast<std::size_t>(c)] : 0.0;
+        laplacian_(p) = m1 * m1 + m2 * m2 + m3 * m3;
+      }
+}
+
+int SpectralGrid::wave_number(int direction, int j) const {
+  const int n = shape_[static_cast<std::size_t>(direction)];
+  return 2 * j < n ? j : j - n;
+}
+
+double SpectralGrid::max_laplacian_symbol() const {
+  double sum = 0.0;
+  for (const int n : shape_) sum += 0.25 * n * n;
+  return sum;
+}
+
+RealVector SpectralGrid::dealias_mask() const {
+  RealVector mask(points_);
+  Index p = 0;
+  const int n1 = shape_[0], n2 = dims() > 1 ? shape_[1] : 1, n3 = dims() > 2 ? shape_[2] : 1;
+  const auto kept = [&](int direction, int j) {
+    return 3 * folded_[static_cast<std::size_t>(direction)][static_cast<std::size_t>(j)] <=
+           shape_[static_cast<std::size_t>(direction)];
+  };
+  for (int a = 0; a < n1; ++a)
+    for (int b = 0; b < n2; ++b)
+      for (int c = 0; c < n3; ++c, ++p)
+        mask(p) = kept(0, a) && (dims() < 2 || kept(1, b)) && (dims() < 3 || kept(2, c)) ? 1.0 : 0.0;
+  return mask;
+}
+
+double SpectralGrid::coordinate(int direction, int j) const {
+  return two_pi * static_cast<double>(j) / shape_[static_cast<std::size_t>(direction)];
+}
+
+std::string SpectralGrid::describe() const {
+  std::string text;
+  for (std::size_t i = 0; i < shape_.size(); ++i) text += (i ? " x " : "") + std::to_string(shape_[i]);
+  return text;
+}
+
+GridTransforms::GridTransforms(const SpectralGrid& grid, Index columns, ThreadLimit fftw_threads)
+    : points_(grid.points()), columns_(columns) {
+  if (columns <= 0 || columns > std::numeric_limits<int>::max())
+    throw Error(fmt::format("GridTransforms: {} columns, expected 1 to 2^31 - 1", columns));
+  const auto values = static_cast<std::size_t>(points_) * static_cast<std::size_t>(columns_);
+  std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
+  buffer_ = reinterpret_cast<Complex*>(fftw_alloc_complex(values));
+  if (!buffer_)
+    throw Error(fmt::format("GridTransforms: cannot allocate {} x {} complex values ({:.3g} GB)", grid.describe(),
+                            columns, 16.0 * static_cast<double>(values) / 1e9));
+  if (detail::fftw_threads_ready())
+    fftw_plan_with_nthreads(fftw_threads.for_size(static_cast<Index>(values)));
+  std::vector<int> shape = grid.shape();
+  auto* data = reinterpret_cast<fftw_complex*>(buffer_);
+  const int signs[2] = {FFTW_FORWARD, FFTW_BACKWARD};
+  const int dist = static_cast<int>(points_);  // checked against int by SpectralGrid
+  for (int d = 0; d < 2; ++d)
+    plans_[d] = fftw_plan_many_dft(grid.dims(), shape.data(), static_cast<int>(columns_), data, nullptr, 1, dist,
+                                   data, nullptr, 1, dist, signs[d], FFTW_ESTIMATE);
+  if (detail::fftw_threads_ready()) fftw_plan_with_nthreads(1);
+  if (!plans_[0] || !plans_[1]) {
+    for (void* plan : plans_)
+      if (plan) fftw_destroy_plan(static_cast<fftw_plan>(plan));
+    fftw_free(buffer_);
+    throw Error(fmt::format("GridTransforms: FFTW could not plan {} x {} transforms", grid.describe(), columns));
+  }
+  std::fill(buffer_, buffer_ + values, Complex(0.0));
+}
+
+GridTransforms::~GridTransforms() {
+  std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
+  for (void* plan : plans_)
+    if (plan) fftw_destroy_plan(static_cast<fftw_plan>(plan));
+  fftw_free(buffer_);
+}
+
+void GridTransforms::forward() { fftw_execute(static_cast<fftw_plan>(plans_[0])); }
+void GridTransforms::backward() { fftw_execute(static_cast<fftw_plan>(plans_[1])); }
+
+Matrix& GridTransforms::scratch() {
+  if (scratch_.size() == 0) scratch_.resize(points_, columns_);
+  return scratch_;
+}
+
+GridTransforms& GridTransformsPool::get(Index columns) {
+  auto it = batches_.find(columns);
+  if (it == batches_.end())
+    it = batches_.emplace(columns, std::make_unique<GridTransforms>(grid_, columns, fftw_threads_)).first;
+  return *it->second;
+}
+
+namespace {
+bool even_size(const Json& v) {
+  const long n = v.get<long>();
+  return n >= 2 && n <= (1L << 20) && n % 2 == 0;
+}
+}  // namespace
+
+ParamSchema spectral_grid_params(const std::string& what) {
+  const std::string even = "an even integer in [2, 1048576]";
+  return {
+      integer_param("dims", 1, "dimension of the grid: 1, 2 or 3 (the torus [0, 2 pi)^dims)")
+          .check([](const Json& v) { return v.get<long>() >= 1 && v.get<long>() <= 3; }, "1, 2 or 3"),
+      integer_param("n_x", 16, "Fourier modes (grid points) in x; u0 is given as " + what + " on the grid")
+          .check(even_size, even),
+      integer_param("n_y", nullptr, "grid points in y (dims >= 2); default n_x").check(even_size, even),
+      integer_param("n_z", nullptr, "grid points in z (dims = 3); default n_x").check(even_size, even)};
+}
+
+std::vector<int> spectral_grid_shape(const Params& params) {
+  const int dims = static_cast<int>(params.integer("dims"));
+  const int n_x = static_cast<int>(params.integer("n_x"));
+  const char* names[3] = {"n_x", "n_y", "n_z"};
+  std::vector<int> shape = {n_x};
+  Index points = n_x;
+  for (int i = 1; i < 3; ++i) {
+    const bool given = params.has(names[i]);
+    if (i >= dims) {
+      if (given)
+        throw ConfigError(std::string("model.") + names[i],
+                          fmt::format("got {}, but dims = {}: the grid has no direction {}", params.integer(names[i]),
+                                      dims, names[i] + 2));
+      continue;
+    }
+    const int n = given ? static_cast<int>(params.integer(names[i])) : n_x;
+    if (points > std::numeric_limits<int>::max() / n)
+      throw ConfigError(std::string("model.") + names[i],
+                        fmt::format("got {}{}: the grid would have more than 2^31 - 1 points", n,
+                                    given ? "" : " (the default, n_x)"));
+    points *= n;
+    shape.push_back(n);
+  }
+  return shape;
+}
+
+}  // namespace tsi
