@@ -7,7 +7,8 @@
 //   nonlinearity_threads/<model>/2  the nonlinearity with FFTW on two threads (large NLS grids)
 //   large/<case>/{nonlinearity,fft_bound,se1,eab}  the same at the sizes where the state
 //                          dominates: NLS n_x = 8192 x n_tau 64 (complex), the synthetic real
-//                          Henon-Heiles ensemble with 2^18 copies x n_tau 16 (the real layout)
+//                          Henon-Heiles ensemble with 2^18 copies x n_tau 16 (the real layout);
+//                          2-D NLS 256 x 256 x n_tau 32 and 3-D NLS 64^3 x n_tau 16 (se1 only)
 //   tau_threads/<model>_ntau<M>/<T> one SE1 step (h = 1/8, eps = 0.01) with the tau grid split
 //                                   over T threads (tsi --threads): Henon-Heiles and the charged
 //                                   particle (4 x 64), NLS and Klein-Gordon n_x = 16 ... 1024
@@ -20,6 +21,7 @@
 
 #include "tsi/assembly.hpp"
 #include "tsi/fft.hpp"
+#include "tsi/spectral_grid.hpp"
 #include "tsi/real_fft.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/plugin_loader.hpp"
@@ -99,11 +101,15 @@ void fft_bound(benchmark::State& state, Case c) {
     }
     return;
   }
-  // The model's own transforms (NLS: in x) happen inside its field; count the tau ones here,
-  // and x ones by a second batch of the same size when the model is a field (complex, dim > 4).
+  // The model's own transforms (NLS: in space) happen inside its field; count the tau ones
+  // here, and the spatial ones by a batch of n_tau fields on the model's grid (its physical
+  // shape: 1, 2 or 3 directions) when the model is a field (complex, dim > 4).
   tsi::FftBatch tau(c.n_tau, static_cast<int>(model->dim()));
   const bool field = model->is_complex() && model->dim() > 4;
-  tsi::FftBatch x(static_cast<int>(model->dim()), c.n_tau);
+  std::vector<int> shape;
+  for (const tsi::Index n : model->physical_shape()) shape.push_back(static_cast<int>(n));
+  const tsi::SpectralGrid grid(field ? shape : std::vector<int>{2});
+  tsi::GridTransforms x(grid, c.n_tau);
   tau.data().setRandom();
   x.data().setRandom();
   for (auto _ : state) {
@@ -170,6 +176,11 @@ std::vector<Case> paper_cases() {
 }
 
 std::string label(const Case& c) {
+  if (c.model_params.value("dims", 1) > 1) {
+    const int n = c.model_params["n_x"].get<int>();
+    return c.model + "_" + std::to_string(c.model_params["dims"].get<int>()) + "d_" + std::to_string(n) + "^" +
+           std::to_string(c.model_params["dims"].get<int>());
+  }
   if (c.model_params.contains("copies")) return c.model + "_" + c.model_params["copies"].dump();
   return c.model_params.contains("n_x") ? c.model + "_nx" + c.model_params["n_x"].dump() : c.model;
 }
@@ -205,6 +216,14 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark((prefix + "fft_bound").c_str(), fft_bound, c);
     for (const char* scheme : {"se1", "eab"})
       benchmark::RegisterBenchmark((prefix + scheme).c_str(), step, c, tsi::Json{{"name", scheme}}, 0.01);
+  }
+  for (const Case& c : {Case{"nls", {{"dims", 2}, {"n_x", 256}}, 32}, Case{"nls", {{"dims", 3}, {"n_x", 64}}, 16}}) {
+    const std::string prefix = "large/" + label(c) + "_ntau" + std::to_string(c.n_tau) + "/";
+    benchmark::RegisterBenchmark((prefix + "nonlinearity").c_str(), nonlinearity, c);
+    benchmark::RegisterBenchmark((prefix + "fft_bound").c_str(), fft_bound, c);
+    benchmark::RegisterBenchmark((prefix + "se1").c_str(), step, c, tsi::Json{{"name", "se1"}}, 0.01);
+    benchmark::RegisterBenchmark((prefix + "nonlinearity_fft_threads/2").c_str(), nonlinearity_threads, c, 2)
+        ->UseRealTime();
   }
   std::vector<Case> threaded = {{"henon-heiles", tsi::Json::object(), 64}, {"cpd", tsi::Json::object(), 64},
                                  {"nls", {{"n_x", 16}}, 32}, {"nls", {{"n_x", 16}}, 64}};

@@ -8,6 +8,7 @@
 
 #include "fftw_planner.hpp"
 #include "tsi/error.hpp"
+#include "tsi/fft.hpp"
 #include "tsi/phase.hpp"
 
 namespace tsi {
@@ -81,20 +82,41 @@ GridTransforms::GridTransforms(const SpectralGrid& grid, Index columns, ThreadLi
   if (columns <= 0 || columns > std::numeric_limits<int>::max())
     throw Error(fmt::format("GridTransforms: {} columns, expected 1 to 2^31 - 1", columns));
   const auto values = static_cast<std::size_t>(points_) * static_cast<std::size_t>(columns_);
+  const std::vector<int>& shape = grid.shape();
+  // A large multi-dimensional field goes one direction at a time: the last (contiguous) by a
+  // plan for its rows, the others through FftBatch's blocks of a few rows at a time (in cache):
+  // FFTW_ESTIMATE's plan for a whole 256 x 256 field walks it once per strided transform, 2.9 ms
+  // against 0.2 ms. Small fields and every 1-D grid: one batched plan over all columns.
+  by_direction_ = grid.dims() > 1 && points_ >= by_direction_points;
+  if (by_direction_) {
+    for (int i = 0; i + 1 < grid.dims(); ++i) {  // direction i: n_i points, stride and count the rest
+      int inner = 1;
+      for (int k = i + 1; k < grid.dims(); ++k) inner *= shape[static_cast<std::size_t>(k)];
+      // On one thread: FFTW's threads would split the strided plans (no blocks), slower here
+      // than one thread (125 ms against 62 at 256 x 256 x 32); a run's threads split its tau grid.
+      strided_.push_back(std::make_unique<FftBatch>(shape[static_cast<std::size_t>(i)], inner));
+    }
+  }
   std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
   buffer_ = reinterpret_cast<Complex*>(fftw_alloc_complex(values));
   if (!buffer_)
     throw Error(fmt::format("GridTransforms: cannot allocate {} x {} complex values ({:.3g} GB)", grid.describe(),
                             columns, 16.0 * static_cast<double>(values) / 1e9));
   if (detail::fftw_threads_ready())
-    fftw_plan_with_nthreads(fftw_threads.for_size(static_cast<Index>(values)));
-  std::vector<int> shape = grid.shape();
+    fftw_plan_with_nthreads(by_direction_ ? 1 : fftw_threads.for_size(static_cast<Index>(values)));
   auto* data = reinterpret_cast<fftw_complex*>(buffer_);
   const int signs[2] = {FFTW_FORWARD, FFTW_BACKWARD};
-  const int dist = static_cast<int>(points_);  // checked against int by SpectralGrid
-  for (int d = 0; d < 2; ++d)
-    plans_[d] = fftw_plan_many_dft(grid.dims(), shape.data(), static_cast<int>(columns_), data, nullptr, 1, dist,
-                                   data, nullptr, 1, dist, signs[d], FFTW_ESTIMATE);
+  for (int d = 0; d < 2; ++d) {
+    if (by_direction_) {  // the last direction of one field: points / n_last rows of n_last
+      const int n_last = shape.back();
+      plans_[d] = fftw_plan_many_dft(1, &n_last, static_cast<int>(points_ / n_last), data, nullptr, 1, n_last, data,
+                                     nullptr, 1, n_last, signs[d], FFTW_ESTIMATE);
+    } else {
+      const int dist = static_cast<int>(points_);  // checked against int by SpectralGrid
+      plans_[d] = fftw_plan_many_dft(grid.dims(), shape.data(), static_cast<int>(columns_), data, nullptr, 1, dist,
+                                     data, nullptr, 1, dist, signs[d], FFTW_ESTIMATE);
+    }
+  }
   if (detail::fftw_threads_ready()) fftw_plan_with_nthreads(1);
   if (!plans_[0] || !plans_[1]) {
     for (void* plan : plans_)
@@ -103,17 +125,36 @@ GridTransforms::GridTransforms(const SpectralGrid& grid, Index columns, ThreadLi
     throw Error(fmt::format("GridTransforms: FFTW could not plan {} x {} transforms", grid.describe(), columns));
   }
   std::fill(buffer_, buffer_ + values, Complex(0.0));
+  if (by_direction_)
+    for (int i = 0; i + 1 < grid.dims(); ++i) {
+      int slab = 1;  // the field is points / slab slabs, each transformed along direction i
+      for (int k = i; k < grid.dims(); ++k) slab *= shape[static_cast<std::size_t>(k)];
+      slabs_.push_back(slab);
+    }
 }
 
 GridTransforms::~GridTransforms() {
+  strided_.clear();  // before the lock: FftBatch takes it itself
   std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
   for (void* plan : plans_)
     if (plan) fftw_destroy_plan(static_cast<fftw_plan>(plan));
   fftw_free(buffer_);
 }
 
-void GridTransforms::forward() { fftw_execute(static_cast<fftw_plan>(plans_[0])); }
-void GridTransforms::backward() { fftw_execute(static_cast<fftw_plan>(plans_[1])); }
+void GridTransforms::execute(int direction) {
+  auto* plan = static_cast<fftw_plan>(plans_[direction]);
+  if (!by_direction_) return fftw_execute(plan);
+  // Every column has the buffer's alignment (points_ even, 16-byte complex values).
+  for (Index j = 0; j < columns_; ++j) {
+    Complex* field = buffer_ + j * points_;
+    fftw_execute_dft(plan, reinterpret_cast<fftw_complex*>(field), reinterpret_cast<fftw_complex*>(field));
+    for (std::size_t i = strided_.size(); i-- > 0;)  // the directions before the last, innermost first
+      for (Index at = 0; at < points_; at += slabs_[i]) strided_[i]->transform(field + at, field + at, direction);
+  }
+}
+
+void GridTransforms::forward() { execute(0); }
+void GridTransforms::backward() { execute(1); }
 
 Matrix& GridTransforms::scratch() {
   if (scratch_.size() == 0) scratch_.resize(points_, columns_);

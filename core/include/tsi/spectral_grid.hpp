@@ -7,6 +7,7 @@
 
 #include "tsi/context.hpp"
 #include "tsi/export.hpp"
+#include "tsi/fft.hpp"
 #include "tsi/params.hpp"
 #include "tsi/types.hpp"
 
@@ -91,8 +92,13 @@ class TSI_API GridTransforms {
   Index columns() const { return columns_; }
 
  private:
+  void execute(int direction);
+  static constexpr Index by_direction_points = 4096;
   Index points_, columns_;
+  bool by_direction_ = false;
   Complex* buffer_ = nullptr;
+  std::vector<std::unique_ptr<FftBatch>> strided_;  // directions 1 .. d-1 of a field, by blocks
+  std::vector<Index> slabs_;                         // points per slab of each of them
   void* plans_[2] = {nullptr, nullptr};  // forward, backward
   Matrix scratch_;
 };

@@ -439,10 +439,14 @@ class Nls final : public tsi::Model,
   tsi::GridTransforms& batch(Index columns) const { return batches_.get(columns); }
 
   // Columns a batched call transforms at once: a large batch (a run's tau grid) goes through
-  // the transforms a slice at a time, so the model's work space is a slice of the state.
+  // the transforms a slice at a time, so the model's work space is a slice of the state: 32
+  // columns, and at most 2^18 values (4 MB; a 2-D or 3-D field is transformed one at a time
+  // anyway, so a larger slice only costs memory: 256 x 256 takes 4 columns, 64^3 one).
   static constexpr Index slice_columns = 32;
+  static constexpr Index slice_values = Index{1} << 18;
   Index slice(Index columns) const {
-    return grid_.points() * columns >= (Index{1} << 16) ? std::min(columns, slice_columns) : columns;
+    if (grid_.points() * columns < (Index{1} << 16)) return columns;
+    return std::min({columns, slice_columns, std::max<Index>(1, slice_values / grid_.points())});
   }
 
   double point_count() const { return static_cast<double>(grid_.points()); }
