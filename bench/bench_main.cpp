@@ -12,7 +12,8 @@
 //   tau_threads/<model>_ntau<M>/<T> one SE1 step (h = 1/8, eps = 0.01) with the tau grid split
 //                                   over T threads (tsi --threads): Henon-Heiles and the charged
 //                                   particle (4 x 64), NLS and Klein-Gordon n_x = 16 ... 1024
-//                                   (n_x x 256): the ratio T = 1 / T = 2 per size sets the threshold
+//                                   (n_x x 256), 2-D and 3-D NLS at the large sizes: the ratio
+//                                   T = 1 / T = 2 per size sets the threshold
 // Models and schemes come from the registry, so a new plugin is benchmarked without edits.
 #include <benchmark/benchmark.h>
 
@@ -229,6 +230,8 @@ int main(int argc, char** argv) {
                                  {"nls", {{"n_x", 16}}, 32}, {"nls", {{"n_x", 16}}, 64}};
   for (const char* model : {"nls", "klein-gordon"})
     for (int n_x : {16, 32, 64, 128, 256, 512, 1024}) threaded.push_back({model, {{"n_x", n_x}}, 256});
+  threaded.push_back({"nls", {{"dims", 2}, {"n_x", 256}}, 32});
+  threaded.push_back({"nls", {{"dims", 3}, {"n_x", 64}}, 16});
   for (const Case& c : threaded)
     for (int threads : {1, 2})
       benchmark::RegisterBenchmark(

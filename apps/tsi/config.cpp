@@ -50,6 +50,10 @@ const ParamSchema& reference_schema() {
       number_param("tol", 1e-13, "the reference solver's tolerance").range(1e-16, 1e-1),
       number_param("h", nullptr, "step of a non-adaptive reference solver; default: t_end")
           .range(0.0, std::numeric_limits<double>::infinity(), true),
+      integer_param("n_tau", nullptr,
+                    "tau modes of a two-scale reference (even); default: the model's (NLS in 2-D needs 4 max |m|^2)")
+          .check([](const Json& v) { return v.get<long>() >= 2 && v.get<long>() <= (1L << 24) && v.get<long>() % 2 == 0; },
+                 "an even integer in [2, 16777216]"),
       bool_param("estimate_accuracy", true,
                  "estimate the reference's own error by a second run at tol / 10 and twice the "
                  "substeps per fast period (at least what rounding its state in model variables "
@@ -72,6 +76,9 @@ Json resolve_reference(const Json& raw, double t_end, const Registry& registry) 
   }
   ref["scheme"] = ref_scheme.info.name;
   ref["reformulation"] = ref_reform.info.name;
+  if (!ref["n_tau"].is_null() && ref_reform.info.name != "two-scale")
+    throw ConfigError("reference.n_tau", "is given, but the reference integrates the " + ref_reform.info.name +
+                                             " problem (n_tau is the two-scale reformulation's)");
   if (!ref_scheme.traits.adaptive && ref["h"].is_null())
     throw ConfigError("reference.h", "the reference scheme \"" + ref_scheme.info.name +
                                          "\" is not adaptive: give its step h");

@@ -53,9 +53,9 @@ Assembly reference_assembly(const Json& config, const Registry& registry, const 
                             const RunSettings& settings) {
   AssemblyOptions options;
   options.context = settings.context;
-  return assemble_config({{"model", config["model"]},
-                          {"reformulation", {{"name", config["reference"]["reformulation"]}}},
-                          {"scheme", scheme_section}},
+  Json reformulation = {{"name", config["reference"]["reformulation"]}};
+  if (config["reference"].value("n_tau", Json()).is_number()) reformulation["n_tau"] = config["reference"]["n_tau"];
+  return assemble_config({{"model", config["model"]}, {"reformulation", reformulation}, {"scheme", scheme_section}},
                          registry, options);
 }
 
