@@ -77,6 +77,50 @@ std::string SpectralGrid::describe() const {
   return text;
 }
 
+std::vector<SpectralGrid::HalfIndex> SpectralGrid::full_to_half() const {
+  const int n_last = shape_.back(), half = n_last / 2 + 1;
+  std::vector<HalfIndex> map(static_cast<std::size_t>(points_));
+  std::array<int, 3> j{0, 0, 0};
+  const std::size_t last = shape_.size() - 1;
+  for (Index p = 0; p < points_; ++p) {
+    // The row of the leading directions' indices, of m or of -m.
+    Index row = 0, mirrored_row = 0;
+    for (std::size_t i = 0; i < last; ++i) {
+      row = row * shape_[i] + j[i];
+      mirrored_row = mirrored_row * shape_[i] + (shape_[i] - j[i]) % shape_[i];
+    }
+    const int jl = j[last];
+    map[static_cast<std::size_t>(p)] = 2 * jl <= n_last ? HalfIndex{row * half + jl, false}
+                                                        : HalfIndex{mirrored_row * half + (n_last - jl), true};
+    for (std::size_t i = shape_.size(); i-- > 0;) {  // the next index, the last direction fastest
+      if (++j[i] < shape_[i]) break;
+      j[i] = 0;
+    }
+  }
+  return map;
+}
+
+std::vector<std::array<Index, 2>> SpectralGrid::half_to_full() const {
+  const int n_last = shape_.back(), half = n_last / 2 + 1;
+  std::vector<std::array<Index, 2>> map;
+  map.reserve(static_cast<std::size_t>(half_points()));
+  const std::size_t last = shape_.size() - 1;
+  std::array<int, 3> j{0, 0, 0};
+  for (Index q = 0; q < half_points(); ++q) {
+    Index full = 0, mirrored = 0;
+    for (std::size_t i = 0; i <= last; ++i) {
+      full = full * shape_[i] + j[i];
+      mirrored = mirrored * shape_[i] + (shape_[i] - j[i]) % shape_[i];
+    }
+    map.push_back({full, mirrored});
+    for (std::size_t i = shape_.size(); i-- > 0;) {  // the next index; the last one runs to n/2
+      if (++j[i] < (i == last ? half : shape_[i])) break;
+      j[i] = 0;
+    }
+  }
+  return map;
+}
+
 GridTransforms::GridTransforms(const SpectralGrid& grid, Index columns, ThreadLimit fftw_threads)
     : points_(grid.points()), columns_(columns) {
   if (columns <= 0 || columns > std::numeric_limits<int>::max())
@@ -157,6 +201,101 @@ void GridTransforms::forward() { execute(0); }
 void GridTransforms::backward() { execute(1); }
 
 Matrix& GridTransforms::scratch() {
+  if (scratch_.size() == 0) scratch_.resize(points_, columns_);
+  return scratch_;
+}
+
+RealGridTransforms::RealGridTransforms(const SpectralGrid& grid, Index columns, ThreadLimit fftw_threads)
+    : points_(grid.points()), half_points_(grid.half_points()), columns_(columns), n_last_(grid.shape().back()) {
+  if (columns <= 0 || columns > std::numeric_limits<int>::max())
+    throw Error(fmt::format("RealGridTransforms: {} columns, expected 1 to 2^31 - 1", columns));
+  const std::vector<int>& shape = grid.shape();
+  const int half = n_last_ / 2 + 1;
+  by_direction_ = grid.dims() > 1 && points_ >= by_direction_points;
+  if (by_direction_)  // the leading directions of the half spectrum, complex, through FftBatch
+    for (int i = 0; i + 1 < grid.dims(); ++i) {
+      int inner = half, slab = half * shape[static_cast<std::size_t>(i)];
+      for (int k = i + 1; k + 1 < grid.dims(); ++k) {
+        inner *= shape[static_cast<std::size_t>(k)];
+        slab *= shape[static_cast<std::size_t>(k)];
+      }
+      strided_.push_back(std::make_unique<FftBatch>(shape[static_cast<std::size_t>(i)], inner));
+      slabs_.push_back(slab);
+    }
+  const auto n_values = static_cast<std::size_t>(points_) * static_cast<std::size_t>(columns_);
+  const auto n_coefficients = static_cast<std::size_t>(half_points_) * static_cast<std::size_t>(columns_);
+  std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
+  values_ = fftw_alloc_real(n_values);
+  spectrum_ = reinterpret_cast<Complex*>(fftw_alloc_complex(n_coefficients));
+  const auto release = [this] {
+    for (void* plan : plans_)
+      if (plan) fftw_destroy_plan(static_cast<fftw_plan>(plan));
+    if (values_) fftw_free(values_);
+    if (spectrum_) fftw_free(spectrum_);
+  };
+  if (!values_ || !spectrum_) {
+    release();
+    throw Error(fmt::format("RealGridTransforms: cannot allocate {} x {} real values ({:.3g} GB)", grid.describe(),
+                            columns, 16.0 * static_cast<double>(n_values) / 1e9));
+  }
+  if (detail::fftw_threads_ready())
+    fftw_plan_with_nthreads(by_direction_ ? 1 : fftw_threads.for_size(static_cast<Index>(n_values)));
+  auto* out = reinterpret_cast<fftw_complex*>(spectrum_);
+  if (by_direction_) {  // the last direction of one field: its rows
+    const int rows = static_cast<int>(points_ / n_last_);
+    plans_[0] = fftw_plan_many_dft_r2c(1, &n_last_, rows, values_, nullptr, 1, n_last_, out, nullptr, 1, half,
+                                       FFTW_ESTIMATE);
+    plans_[1] = fftw_plan_many_dft_c2r(1, &n_last_, rows, out, nullptr, 1, half, values_, nullptr, 1, n_last_,
+                                       FFTW_ESTIMATE);
+  } else {
+    const int dist_values = static_cast<int>(points_), dist_spectrum = static_cast<int>(half_points_);
+    plans_[0] = fftw_plan_many_dft_r2c(grid.dims(), shape.data(), static_cast<int>(columns_), values_, nullptr, 1,
+                                       dist_values, out, nullptr, 1, dist_spectrum, FFTW_ESTIMATE);
+    plans_[1] = fftw_plan_many_dft_c2r(grid.dims(), shape.data(), static_cast<int>(columns_), out, nullptr, 1,
+                                       dist_spectrum, values_, nullptr, 1, dist_values, FFTW_ESTIMATE);
+  }
+  if (detail::fftw_threads_ready()) fftw_plan_with_nthreads(1);
+  if (!plans_[0] || !plans_[1]) {
+    release();
+    throw Error(fmt::format("RealGridTransforms: FFTW could not plan {} x {} transforms", grid.describe(), columns));
+  }
+  std::fill(values_, values_ + n_values, 0.0);
+  std::fill(spectrum_, spectrum_ + n_coefficients, Complex(0.0));
+}
+
+RealGridTransforms::~RealGridTransforms() {
+  strided_.clear();  // before the lock: FftBatch takes it itself
+  std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
+  for (void* plan : plans_)
+    if (plan) fftw_destroy_plan(static_cast<fftw_plan>(plan));
+  fftw_free(values_);
+  fftw_free(spectrum_);
+}
+
+void RealGridTransforms::forward() {
+  auto* plan = static_cast<fftw_plan>(plans_[0]);
+  if (!by_direction_) return fftw_execute(plan);
+  for (Index j = 0; j < columns_; ++j) {
+    Complex* field = spectrum_ + j * half_points_;
+    // Columns keep the buffers' alignment: points_ even (doubles) and 16-byte complex values.
+    fftw_execute_dft_r2c(plan, values_ + j * points_, reinterpret_cast<fftw_complex*>(field));
+    for (std::size_t i = strided_.size(); i-- > 0;)
+      for (Index at = 0; at < half_points_; at += slabs_[i]) strided_[i]->transform(field + at, field + at, 0);
+  }
+}
+
+void RealGridTransforms::backward() {
+  auto* plan = static_cast<fftw_plan>(plans_[1]);
+  if (!by_direction_) return fftw_execute(plan);
+  for (Index j = 0; j < columns_; ++j) {
+    Complex* field = spectrum_ + j * half_points_;
+    for (std::size_t i = 0; i < strided_.size(); ++i)
+      for (Index at = 0; at < half_points_; at += slabs_[i]) strided_[i]->transform(field + at, field + at, 1);
+    fftw_execute_dft_c2r(plan, reinterpret_cast<fftw_complex*>(field), values_ + j * points_);
+  }
+}
+
+RealMatrix& RealGridTransforms::scratch() {
   if (scratch_.size() == 0) scratch_.resize(points_, columns_);
   return scratch_;
 }

@@ -2,6 +2,7 @@
 // symbols, and the batched d-dimensional transforms against plane waves computed by hand.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 
@@ -79,6 +80,49 @@ TEST_CASE("spectral grid: a shape of 0 or 4 directions, or an odd size, is an er
   CHECK_THROWS_WITH_AS(tsi::SpectralGrid({}), doctest::Contains("expected 1, 2 or 3"), tsi::Error);
   CHECK_THROWS_WITH_AS(tsi::SpectralGrid({4, 4, 4, 4}), doctest::Contains("expected 1, 2 or 3"), tsi::Error);
   CHECK_THROWS_WITH_AS(tsi::SpectralGrid({4, 5}), doctest::Contains("direction 2 has 5 points"), tsi::Error);
+}
+
+}  // namespace
+
+namespace {
+
+TEST_CASE("spectral grid: real-to-complex transforms give the complex transform's half spectrum, and back") {
+  // Batched (small grids) and by direction (from 4096 points), with odd half widths (n_d/2 + 1).
+  for (const std::vector<int>& shape : {std::vector<int>{8}, std::vector<int>{6, 4}, std::vector<int>{4, 6, 10},
+                                        std::vector<int>{64, 64}, std::vector<int>{32, 128}, std::vector<int>{16, 8, 34}}) {
+    const tsi::SpectralGrid grid(shape);
+    CAPTURE(grid.describe());
+    tsi::RealGridTransforms real(grid, 2);
+    tsi::GridTransforms full(grid, 2);
+    real.values().setRandom();
+    const tsi::RealMatrix values = real.values();
+    full.data() = values.cast<Complex>();
+    real.forward();
+    full.forward();
+    const auto to_half = grid.full_to_half();
+    const auto to_full = grid.half_to_full();
+    REQUIRE(static_cast<Index>(to_full.size()) == grid.half_points());
+    double worst = 0.0;
+    for (Index j = 0; j < 2; ++j)
+      for (Index p = 0; p < grid.points(); ++p) {
+        const auto [at, conjugate] = to_half[static_cast<std::size_t>(p)];
+        const Complex stored = real.spectrum()(at, j);
+        worst = std::max(worst, std::abs((conjugate ? std::conj(stored) : stored) - full.data()(p, j)));
+      }
+    CHECK(worst < 1e-12 * static_cast<double>(grid.points()));
+    // half_to_full: the stored coefficient is that of m, and the conjugate of that of -m.
+    double worst_m = 0.0, worst_minus_m = 0.0;
+    for (Index q = 0; q < grid.half_points(); ++q) {
+      const auto [m, minus_m] = to_full[static_cast<std::size_t>(q)];
+      worst_m = std::max(worst_m, std::abs(real.spectrum()(q, 0) - full.data()(m, 0)));
+      worst_minus_m = std::max(worst_minus_m, std::abs(real.spectrum()(q, 0) - std::conj(full.data()(minus_m, 0))));
+    }
+    CHECK(worst_m < 1e-12 * static_cast<double>(grid.points()));
+    CHECK(worst_minus_m < 1e-12 * static_cast<double>(grid.points()));
+    real.backward();  // backward(forward(a)) = N a
+    CHECK((real.values() - static_cast<double>(grid.points()) * values).norm() <
+          1e-13 * values.norm() * static_cast<double>(grid.points()));
+  }
 }
 
 }  // namespace

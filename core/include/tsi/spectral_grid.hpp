@@ -1,5 +1,6 @@
 #pragma once
 #include <array>
+#include <utility>
 #include <map>
 #include <memory>
 #include <string>
@@ -59,6 +60,20 @@ class TSI_API SpectralGrid {
   /// "16", "256 x 256", "64 x 64 x 64".
   std::string describe() const;
 
+  /// Points of the half spectrum of a real field (RealGridTransforms): every wave number of
+  /// the leading directions and 0 .. n_d/2 of the last, in C order.
+  Index half_points() const { return points_ / shape_.back() * (shape_.back() / 2 + 1); }
+  /// Where a full spectrum's coefficient (point p) is in the half spectrum of a real field:
+  /// its index there, and whether the coefficient is the conjugate of the one stored (the last
+  /// direction's index above n_d/2 holds the coefficient of -m).
+  struct HalfIndex {
+    Index at;
+    bool conjugate;
+  };
+  std::vector<HalfIndex> full_to_half() const;
+  /// For every point of the half spectrum: its index in the full spectrum (m) and that of -m.
+  std::vector<std::array<Index, 2>> half_to_full() const;
+
  private:
   std::vector<int> shape_;
   Index points_ = 1;
@@ -101,6 +116,45 @@ class TSI_API GridTransforms {
   std::vector<Index> slabs_;                         // points per slab of each of them
   void* plans_[2] = {nullptr, nullptr};  // forward, backward
   Matrix scratch_;
+};
+
+/// Real-to-complex transforms of `columns` real fields on a SpectralGrid: field j's values
+/// (column j of points x columns) to its half spectrum (column j of half_points() x columns,
+/// SpectralGrid::half_points' order) and back, FFTW's r2c and c2r, unnormalised as
+/// GridTransforms: half the work and memory of complex transforms, for fields that are real on
+/// the grid (Klein-Gordon's z). backward() reads the half spectrum as Hermitian (the imaginary
+/// parts of self-conjugate modes are ignored) and overwrites it. Large multi-dimensional fields
+/// go by direction as GridTransforms' do.
+class TSI_API RealGridTransforms {
+ public:
+  RealGridTransforms(const SpectralGrid& grid, Index columns, ThreadLimit fftw_threads = {});
+  ~RealGridTransforms();
+  RealGridTransforms(const RealGridTransforms&) = delete;
+  RealGridTransforms& operator=(const RealGridTransforms&) = delete;
+
+  /// points x columns real values.
+  Eigen::Map<RealMatrix> values() { return Eigen::Map<RealMatrix>(values_, points_, columns_); }
+  /// half_points x columns coefficients.
+  Eigen::Map<Matrix> spectrum() { return Eigen::Map<Matrix>(spectrum_, half_points_, columns_); }
+  /// values -> spectrum (the values are kept).
+  void forward();
+  /// spectrum -> values (the spectrum is overwritten).
+  void backward();
+  /// A second set of values of the same shape (a derivative's z), allocated on first use.
+  RealMatrix& scratch();
+  Index columns() const { return columns_; }
+
+ private:
+  static constexpr Index by_direction_points = 4096;
+  Index points_, half_points_, columns_;
+  int n_last_;
+  bool by_direction_ = false;
+  double* values_ = nullptr;
+  Complex* spectrum_ = nullptr;
+  void* plans_[2] = {nullptr, nullptr};              // r2c, c2r
+  std::vector<std::unique_ptr<FftBatch>> strided_;  // by direction: the leading directions
+  std::vector<Index> slabs_;
+  RealMatrix scratch_;
 };
 
 /// GridTransforms for every batch size a model meets, planned on first use and kept: a run sees

@@ -48,6 +48,7 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -90,6 +91,9 @@ class KleinGordon final : public tsi::Model,
         volume_(std::pow(tsi::two_pi, grid_.dims())),
         inverse_a_(n_x_),
         remainder_(n_x_),
+        fftw_threads_(fftw_threads),
+        full_to_half_(grid_.full_to_half()),
+        half_to_full_(grid_.half_to_full()),
         batches_(grid_, fftw_threads) {
     for (Index j = 0; j < n_x_; ++j) {
       const double k2 = grid_.laplacian_symbol()(j);  // |k|^2, the Nyquist index as +n/2
@@ -118,12 +122,12 @@ class KleinGordon final : public tsi::Model,
   // i lambda sqrt(2 pi) / n_x a^{-1} forward(z^3), z = Re backward(a^{-1} c) / sqrt(2 pi).
   void nonlinear_field(ConstMatrixRef c, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    fused_field<false>(Phases{}, batch(c.cols()), c, out);
+    fused_field<false>(Phases{}, real_batch(c.cols()), c, out);
   }
 
   void filtered_field(const tsi::RealVector& taus, MatrixRef c, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    fused_field<true>(Phases(taus), batch(c.cols()), c, out);
+    fused_field<true>(Phases(taus), real_batch(c.cols()), c, out);
   }
 
   // A run's tau grid: cos and sin of its phases, and transforms of its own (no lock: one run's
@@ -131,13 +135,13 @@ class KleinGordon final : public tsi::Model,
   class GridField final : public tsi::TauGridField {
    public:
     GridField(const KleinGordon& model, const tsi::RealVector& taus)
-        : model_(model), phases_(taus), batch_(model.grid_, taus.size(), model.batches_.fftw_threads()) {}
+        : model_(model), phases_(taus), batch_(model.grid_, taus.size(), model.fftw_threads_) {}
     void evaluate(MatrixRef c, MatrixRef out) override { model_.fused_field<true>(phases_, batch_, c, out); }
 
    private:
     const KleinGordon& model_;
     Phases phases_;
-    tsi::GridTransforms batch_;
+    tsi::RealGridTransforms batch_;
   };
 
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
@@ -146,60 +150,53 @@ class KleinGordon final : public tsi::Model,
   // Each binding owns its tables and transforms: bindings may run on different threads.
   bool independent_tau_grid_bindings() const override { return true; }
 
-  // f_tau(c) = e^{-i tau} N(e^{i tau} c) in one pass each way. Since e^{JM tau} is the scalar
-  // e^{i tau}, backward(a^{-1} e^{i tau} c) = e^{i tau} g with g = backward(a^{-1} c): the phase
-  // enters only the real part taken on the grid, z = cos tau Re g - sin tau Im g (up to
-  // sqrt(2 pi)), and leaves as e^{-i tau} on the way out. Without Rotate, tau = 0 (the field
-  // N itself; `phases` is not read). `c` is not written.
+  // f_tau(c) = e^{-i tau} N(e^{i tau} c) in one pass each way, in real transforms. Since e^{JM tau}
+  // is the scalar e^{i tau}, backward(a^{-1} e^{i tau} c) = e^{i tau} g with g = backward(a^{-1} c):
+  // the phase enters only the real part taken on the grid, z = Re(e^{i tau} g) (up to (2 pi)^{d/2}),
+  // and leaves as e^{-i tau} on the way out. The real part of a backward transform of y is the
+  // c2r transform of y's Hermitian part (y_m + conj(y_{-m})) / 2, and z^3 is real, so its forward
+  // transform is the r2c one, the coefficients of -m the conjugates of those of m. Without
+  // Rotate, tau = 0 (the field N itself; `phases` is not read). `c` is read before `out` is
+  // written: they may be the same.
   template <bool Rotate>
-  void fused_field(const Phases& phases, tsi::GridTransforms& b, ConstMatrixRef c, MatrixRef out) const {
-    auto w = b.data();  // column j: state j
+  void fused_field(const Phases& phases, tsi::RealGridTransforms& b, ConstMatrixRef c, MatrixRef out) const {
     const Index cols = c.cols();
-    for (Index j = 0; j < cols; ++j)
-      for (Index k = 0; k < n_x_; ++k) w(k, j) = inverse_a_(k) * c(k, j);
-    b.backward();
-    // backward(a^{-1} c) = sqrt(2 pi) g; z^3 is Re(.)^3 / (2 pi)^{3/2}, and the field's factor
-    // sqrt(2 pi) / n_x: lambda Re(.)^3 / (2 pi n_x), real, before the forward transform.
-    const double scale = lambda_ / (volume_ * point_count());
     for (Index j = 0; j < cols; ++j) {
-      const double co = Rotate ? phases.cos(j) : 1.0, si = Rotate ? phases.sin(j) : 0.0;
-      for (Index k = 0; k < n_x_; ++k) {
-        const double re = Rotate ? co * w(k, j).real() - si * w(k, j).imag() : w(k, j).real();
-        w(k, j) = scale * re * re * re;
-      }
+      const Complex turn = Rotate ? Complex(phases.cos(j), phases.sin(j)) : Complex(1.0, 0.0);  // e^{i tau}
+      hermitian_part(c.col(j), Rotate, turn, b.spectrum().col(j));
     }
+    b.backward();
+    // backward(a^{-1} c) = (2 pi)^{d/2} g; z^3 is Re(.)^3 / (2 pi)^{3d/2}, and the field's factor
+    // (2 pi)^{d/2} / N: lambda Re(.)^3 / ((2 pi)^d N), real, before the forward transform.
+    const double scale = lambda_ / (volume_ * point_count());
+    auto z = b.values();
+    z = scale * z.array().cube().matrix();
     b.forward();
     // out = i e^{-i tau} a^{-1} F: i e^{-i tau} = sin tau + i cos tau.
     for (Index j = 0; j < cols; ++j) {
       const Complex turn = Rotate ? Complex(phases.sin(j), phases.cos(j)) : Complex(0.0, 1.0);
-      for (Index k = 0; k < n_x_; ++k) out(k, j) = inverse_a_(k) * times(w(k, j), turn);
+      expand_times(b.spectrum().col(j), turn, out.col(j));
     }
   }
 
-  // D(J grad H1)(c) d = i lambda sqrt(2 pi) / n_x a^{-1} forward(3 z^2 dz), dz the real part of
-  // backward(a^{-1} d) / sqrt(2 pi): same scaling as the field.
+  // D(J grad H1)(c) d = i lambda (2 pi)^{d/2} / N a^{-1} forward(3 z^2 dz), dz the real part of
+  // backward(a^{-1} d) / (2 pi)^{d/2}: same scaling as the field.
   void nonlinear_field_derivative(ConstMatrixRef c, ConstMatrixRef d, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
     const Index cols = c.cols();
-    tsi::GridTransforms& b = batch(cols);
-    tsi::Matrix& grid = b.scratch();
-    auto w = b.data();  // column j: state j
-    for (Index j = 0; j < cols; ++j)
-      for (Index k = 0; k < n_x_; ++k) w(k, j) = inverse_a_(k) * c(k, j);
+    tsi::RealGridTransforms& b = real_batch(cols);
+    const Complex one(1.0, 0.0);
+    for (Index j = 0; j < cols; ++j) hermitian_part(c.col(j), false, one, b.spectrum().col(j));
     b.backward();
-    grid = w;
-    for (Index j = 0; j < cols; ++j)
-      for (Index k = 0; k < n_x_; ++k) w(k, j) = inverse_a_(k) * d(k, j);
+    tsi::RealMatrix& z = b.scratch();
+    z = b.values();
+    for (Index j = 0; j < cols; ++j) hermitian_part(d.col(j), false, one, b.spectrum().col(j));
     b.backward();
     const double scale = 3.0 * lambda_ / (volume_ * point_count());
-    for (Index j = 0; j < cols; ++j)
-      for (Index k = 0; k < n_x_; ++k) {
-        const double z = grid(k, j).real();
-        w(k, j) = scale * z * z * w(k, j).real();
-      }
+    auto dz = b.values();
+    dz = (scale * z.array().square() * dz.array()).matrix();
     b.forward();
-    for (Index j = 0; j < cols; ++j)
-      for (Index k = 0; k < n_x_; ++k) out(k, j) = inverse_a_(k) * Complex(0.0, 1.0) * w(k, j);
+    for (Index j = 0; j < cols; ++j) expand_times(b.spectrum().col(j), Complex(0.0, 1.0), out.col(j));
   }
 
   void apply_M(const Vector& u, Vector& out) const override { out = u; }
@@ -208,11 +205,10 @@ class KleinGordon final : public tsi::Model,
   // (lambda / 4) (2 pi / n_x) sum z_j^4 with z_j = Re backward(a^{-1} c)_j / sqrt(2 pi).
   double H1(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batch(1);
-    auto w = b.data();
-    w.col(0) = inverse_a_.cwiseProduct(c);
+    tsi::RealGridTransforms& b = real_batch(1);
+    hermitian_part(c, false, Complex(1.0, 0.0), b.spectrum().col(0));
     b.backward();
-    return lambda_ * w.col(0).real().array().pow(4).sum() / (4.0 * volume_ * point_count());
+    return lambda_ * b.values().col(0).array().pow(4).sum() / (4.0 * volume_ * point_count());
   }
 
   const tsi::RealVector& linear_remainder() const override { return remainder_; }
@@ -271,6 +267,40 @@ class KleinGordon final : public tsi::Model,
   // The transforms for batches of `columns` states, planned on first use and kept. Callers
   // hold mutex_.
   tsi::GridTransforms& batch(Index columns) const { return batches_.get(columns); }
+  // Real transforms for batches of `columns` fields, planned on first use and kept. Callers
+  // hold mutex_.
+  tsi::RealGridTransforms& real_batch(Index columns) const {
+    auto it = real_batches_.find(columns);
+    if (it == real_batches_.end())
+      it = real_batches_.emplace(columns, std::make_unique<tsi::RealGridTransforms>(grid_, columns, fftw_threads_)).first;
+    return *it->second;
+  }
+
+  // The half spectrum of the Hermitian part of y = turn a^{-1} c (turn = e^{i tau} where
+  // `rotate`): (y_m + conj(y_{-m})) / 2 at every point of the half spectrum.
+  template <class In, class Out>
+  void hermitian_part(const In& c, bool rotate, Complex turn, Out&& half) const {
+    for (Index q = 0; q < static_cast<Index>(half_to_full_.size()); ++q) {
+      const auto [m, minus_m] = half_to_full_[static_cast<std::size_t>(q)];
+      Complex y = inverse_a_(m) * c(m), y_minus = inverse_a_(minus_m) * c(minus_m);
+      if (rotate) {
+        y = times(y, turn);
+        y_minus = times(y_minus, turn);
+      }
+      half(q) = 0.5 * (y + std::conj(y_minus));
+    }
+  }
+
+  // out_m = a_m^{-1} turn F_m for every m of the full spectrum, F the half spectrum of a real
+  // field (F_{-m} = conj F_m).
+  template <class In, class Out>
+  void expand_times(const In& half, Complex turn, Out&& out) const {
+    for (Index m = 0; m < n_x_; ++m) {
+      const auto [at, conjugate] = full_to_half_[static_cast<std::size_t>(m)];
+      const Complex f = conjugate ? std::conj(half(at)) : half(at);
+      out(m) = inverse_a_(m) * times(f, turn);
+    }
+  }
   double point_count() const { return static_cast<double>(n_x_); }
 
   // a b, written out: std::complex's operator* tests every product for inf/NaN.
@@ -285,7 +315,11 @@ class KleinGordon final : public tsi::Model,
   tsi::RealVector inverse_a_;  // a_k^{-1} = (1 + eps k^2)^{-1/4}
   tsi::RealVector remainder_;  // A_k = k^2 / (1 + sqrt(1 + eps k^2))
   mutable std::mutex mutex_;   // the batches' buffers are shared work space
-  mutable tsi::GridTransformsPool batches_;
+  tsi::ThreadLimit fftw_threads_;
+  std::vector<tsi::SpectralGrid::HalfIndex> full_to_half_;    // where each coefficient is in a half spectrum
+  std::vector<std::array<Index, 2>> half_to_full_;            // m and -m of each half-spectrum point
+  mutable tsi::GridTransformsPool batches_;                   // complex: the physical variables
+  mutable std::map<Index, std::unique_ptr<tsi::RealGridTransforms>> real_batches_;  // real: z and the field
 };
 
 void register_klein_gordon(tsi::Registry& registry) {
