@@ -110,4 +110,23 @@ TEST_CASE("every two-scale scheme steps without allocating on a large NLS grid (
   }
 }
 
+TEST_CASE("SE1 steps without allocating on 2-D and 3-D grids (NLS and Klein-Gordon, transforms by direction)") {
+  // 64 x 64 and 16 x 16 x 16: 4096 points, the transforms one direction at a time through
+  // FftBatch's blocks; Klein-Gordon's in real transforms.
+  auto& h = tsi::test::Harness::instance();
+  for (const char* name : {"nls", "klein-gordon"})
+    for (const tsi::Json& grid : {tsi::Json{{"dims", 2}, {"n_x", 64}}, tsi::Json{{"dims", 3}, {"n_x", 16}}}) {
+      CAPTURE(std::string(name));
+      CAPTURE(grid.dump());
+      auto model = h.model_with(name, 0.1, grid);
+      auto two_scale = h.reformulation("two-scale", model, {{"n_tau", 16}});
+      auto stepper = h.scheme("se1", tsi::Json::object(), name)->bind(*two_scale, 1e-3);
+      tsi::Vector y = two_scale->prepare(model->initial_value());
+      stepper->step(0.0, y);
+      const long before = allocations.load();
+      for (int n = 1; n <= 3; ++n) stepper->step(1e-3 * n, y);
+      CHECK(allocations.load() - before == 0);
+    }
+}
+
 #endif  // !__SANITIZE_ADDRESS__

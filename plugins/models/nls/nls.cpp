@@ -21,6 +21,10 @@
 // like e^{-0.88 |m_i|} in each direction); "plane-wave", u = a e^{i k.x} (`amplitude` a,
 // `wave_vector` k), whose exact solution a e^{i k.x} e^{-i (|k|^2/eps + a^2) t} the model
 // declares (a run's reference.scheme "exact").
+//
+// `dealias`: the 2/3 rule (tsi::SpectralGrid::dealias_mask, P): the field is P(-i |u|^2 u) and u0
+// is P u0. The run then stays in P's band, where the system is Hamiltonian for the same H1
+// restricted to it (the gradient of the restriction is P grad H1), so H is conserved as before.
 #include <cmath>
 #include <algorithm>
 #include <array>
@@ -144,10 +148,12 @@ class Nls final : public tsi::Model,
                   public tsi::ExactSolution {
  public:
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
-  Nls(double eps, std::vector<int> shape, InitialData initial, tsi::ThreadLimit fftw_threads = {})
+  // dealias: the 2/3 rule on the field (and on u0), see the header.
+  Nls(double eps, std::vector<int> shape, InitialData initial, bool dealias, tsi::ThreadLimit fftw_threads = {})
       : Model(eps),
         grid_(std::move(shape)),
         initial_(initial),
+        dealias_(dealias ? grid_.dealias_mask() : tsi::RealVector()),
         volume_(std::pow(tsi::two_pi, grid_.dims())),
         batches_(grid_, fftw_threads) {
     batch(1);  // the single-state plans (filtered, direct, invariants)
@@ -158,7 +164,8 @@ class Nls final : public tsi::Model,
 
   const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
   const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
-  const tsi::ExactNonlinearFlow* exact_nonlinear_flow() const override { return this; }
+  // Dealiased, the field's flow is no longer u e^{-i |u|^2 t} on the grid.
+  const tsi::ExactNonlinearFlow* exact_nonlinear_flow() const override { return dealias_.size() ? nullptr : this; }
   const tsi::PhysicalVariables* physical_variables() const override { return this; }
   const tsi::ExactSolution* exact_solution() const override { return initial_.plane_wave ? this : nullptr; }
 
@@ -187,6 +194,7 @@ class Nls final : public tsi::Model,
         for (Index i = 0; i < w.rows(); ++i) w(i, j) *= scale * std::norm(w(i, j));
       b.forward();
       out.middleCols(j0, k) = w.leftCols(k);
+      dealias(out.middleCols(j0, k));
     }
   }
 
@@ -262,6 +270,7 @@ class Nls final : public tsi::Model,
         phases.set(taus(j0 + j), tables, j0 + j);
         phases.for_each_point([&](Index p, Complex e) { out(p, j0 + j) = times_conj(w(p, j), e); });
       }
+      dealias(out.middleCols(j0, k));
     }
   }
 
@@ -292,6 +301,7 @@ class Nls final : public tsi::Model,
         }
       b.forward();
       out.middleCols(j0, k) = w.leftCols(k);
+      dealias(out.middleCols(j0, k));
     }
   }
 
@@ -381,7 +391,7 @@ class Nls final : public tsi::Model,
       for (int i = 1; i < grid_.dims(); ++i) value *= paper_profile(at[static_cast<std::size_t>(i)]);
       x(p) = value;
     });
-    return from_physical(x);
+    return from_physical(x);  // dealiased there
   }
 
   // The plane wave a e^{i k.x} e^{-i (|k|^2/eps + a^2) t}: x0 times the phase, where x0 is that
@@ -414,7 +424,9 @@ class Nls final : public tsi::Model,
     auto w = b.data();
     w.col(0) = x;
     b.forward();
-    return w.col(0) * (std::sqrt(volume_) / static_cast<double>(grid_.points()));
+    Vector c = w.col(0) * (std::sqrt(volume_) / static_cast<double>(grid_.points()));
+    dealias(c);
+    return c;
   }
 
   // c -> grid samples u_j = backward(c)_j / (2 pi)^{d/2}.
@@ -451,6 +463,13 @@ class Nls final : public tsi::Model,
 
   double point_count() const { return static_cast<double>(grid_.points()); }
 
+  // With the 2/3 rule, the modes outside its band set to zero (columns of coefficients).
+  template <class Columns>
+  void dealias(Columns&& c) const {
+    if (dealias_.size())
+      for (Index j = 0; j < c.cols(); ++j) c.col(j).array() *= dealias_.array();
+  }
+
   static Complex paper_profile(double x) {
     const double s = std::sin(x);
     return std::polar(1.0, x) / (1.0 + s * s);
@@ -458,6 +477,7 @@ class Nls final : public tsi::Model,
 
   tsi::SpectralGrid grid_;
   InitialData initial_;
+  tsi::RealVector dealias_;    // the 2/3 rule's mask, or empty
   double volume_;              // (2 pi)^d
   mutable std::mutex mutex_;   // the batches' buffers and phases_ are shared work space
   mutable tsi::GridTransformsPool batches_;
@@ -511,13 +531,17 @@ void register_nls(tsi::Registry& registry) {
   entry.info.params.push_back(
       tsi::number_param("amplitude", nullptr, "the plane wave's amplitude a; default 1")
           .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number"));
+  entry.info.params.push_back(tsi::bool_param(
+      "dealias", false,
+      "the 2/3 rule: the field's modes with some |m_i| > n_i/3 set to zero, and u0's too (the run stays in the "
+      "band, where H is conserved; no exact nonlinear flow, so no Strang)"));
   entry.default_n_tau = 256;
   entry.nonlinearity_degree = 3;
   entry.verification = {{1.0, 1.0 / 16, 1.0 / 256}, {4, 8, 16, 32}};
   entry.create = [](const tsi::Params& p) {
     std::vector<int> shape = tsi::spectral_grid_shape(p);
     const InitialData initial = initial_data(p, shape);
-    return std::make_unique<Nls>(p.number("eps"), std::move(shape), initial, p.context().fft);
+    return std::make_unique<Nls>(p.number("eps"), std::move(shape), initial, p.boolean("dealias"), p.context().fft);
   };
   registry.add_model(std::move(entry));
 }
