@@ -127,9 +127,10 @@ std::shared_ptr<const Model> model_with_exact_solution(const Json& config, const
       registry.model(config["model"]["name"]).create(Params(without_name(config["model"]), settings.context));
   if (!model->exact_solution())
     throw ConfigError("reference.scheme",
-                      fmt::format("got \"{}\", but the model \"{}\" declares no exact solution (the matrix model has "
-                                  "one with an affine field such as \"linear\"); choose a reference solver, e.g. "
-                                  "\"rk78\"",
+                      fmt::format("got \"{}\", but the model \"{}\" declares no exact solution for these parameters "
+                                  "(the matrix model has one with an affine field such as \"linear\", nls with "
+                                  "initial \"plane-wave\", klein-gordon with it and lambda 0); choose a reference "
+                                  "solver, e.g. \"rk78\"",
                                   exact_reference, config["model"]["name"].get<std::string>()));
   return model;
 }

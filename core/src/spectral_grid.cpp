@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "fftw_planner.hpp"
@@ -323,6 +324,57 @@ ParamSchema spectral_grid_params(const std::string& what) {
           .check(even_size, even),
       integer_param("n_y", nullptr, "grid points in y (dims >= 2); default n_x").check(even_size, even),
       integer_param("n_z", nullptr, "grid points in z (dims = 3); default n_x").check(even_size, even)};
+}
+
+double PlaneWave::k2() const {
+  double sum = 0.0;
+  for (const int k : wave_vector) sum += static_cast<double>(k) * k;
+  return sum;
+}
+
+Complex PlaneWave::at(const std::array<double, 3>& x) const {
+  double phase = 0.0;
+  for (std::size_t i = 0; i < 3; ++i) phase += wave_vector[i] * x[i];
+  return std::polar(amplitude, phase);
+}
+
+ParamSchema initial_data_params(const std::string& default_name, const std::string& default_doc) {
+  return {string_param("initial", default_name,
+                       "initial data: \"" + default_name + "\" (" + default_doc +
+                           ") or \"plane-wave\" (amplitude e^{i k.x})")
+              .choices({default_name, "plane-wave"}),
+          array_param("wave_vector", "the plane wave's k, one integer per direction with |k_i| < n_i/2; default (1, 0, 0)"),
+          number_param("amplitude", nullptr, "the plane wave's amplitude a; default 1")
+              .check([](const Json& v) { return std::isfinite(v.get<double>()); }, "a finite number")};
+}
+
+std::optional<PlaneWave> plane_wave(const Params& p, const std::vector<int>& shape) {
+  if (p.string("initial") != "plane-wave") {
+    for (const char* key : {"wave_vector", "amplitude"})
+      if (p.has(key))
+        throw ConfigError(std::string("model.") + key, "is given, but model.initial is \"" + p.string("initial") +
+                                                           "\" (it belongs to \"plane-wave\")");
+    return std::nullopt;
+  }
+  PlaneWave wave;
+  if (p.has("amplitude")) wave.amplitude = p.number("amplitude");
+  if (!p.has("wave_vector")) return wave;
+  const Json& k = p.raw().at("wave_vector");
+  const std::size_t dims = shape.size();
+  if (k.size() != dims)
+    throw ConfigError("model.wave_vector",
+                      fmt::format("got {}, expected {} integers (one per direction, dims = {})", k.dump(), dims, dims));
+  wave.wave_vector = {0, 0, 0};
+  for (std::size_t i = 0; i < dims; ++i) {
+    const Json& v = k.at(i);
+    const int n = shape[i];
+    // Resolved on the grid: |k_i| < n_i / 2 (the Nyquist mode has no sign).
+    if (!v.is_number_integer() || std::abs(v.get<long>()) >= n / 2)
+      throw ConfigError(fmt::format("model.wave_vector[{}]", i),
+                        fmt::format("got {}, expected an integer of magnitude below n/2 = {}", v.dump(), n / 2));
+    wave.wave_vector[i] = static_cast<int>(v.get<long>());
+  }
+  return wave;
 }
 
 std::vector<int> spectral_grid_shape(const Params& params) {

@@ -322,3 +322,36 @@ TEST_CASE("nls with dealias: the field lives in the 2/3 band, the run stays ther
 }
 
 }  // namespace
+
+namespace {
+
+TEST_CASE("klein-gordon in 2-D and 3-D: at lambda = 0 the plane wave is exact, and every two-scale scheme meets it") {
+  // v = a e^{i k.x} e^{i omega_k t}, omega_k = sqrt(1 + eps |k|^2) / eps: the linear part (1/eps and
+  // the remainder A_k = |k|^2 / (1 + sqrt(1 + eps |k|^2)), integrated exactly by the schemes) alone.
+  // The error is the rounding of the phases, which grow as 1/eps (the exact value's accuracy).
+  auto& h = Harness::instance();
+  const std::vector<Json> waves = {
+      {{"dims", 2}, {"n_x", 8}, {"n_y", 6}, {"initial", "plane-wave"}, {"wave_vector", {3, -2}}, {"lambda", 0.0}},
+      {{"dims", 3}, {"n_x", 4}, {"n_y", 6}, {"n_z", 8}, {"initial", "plane-wave"}, {"wave_vector", {1, 2, -3}},
+       {"amplitude", 0.7}, {"lambda", 0.0}}};
+  for (const Json& wave : waves)
+    for (double eps : {1.0, 1e-3, 1e-6})
+      for (const auto* scheme : tsi::test::two_scale_schemes()) {
+        auto model = h.model_with("klein-gordon", eps, wave);
+        REQUIRE(model->exact_solution() != nullptr);
+        auto two_scale = h.reformulation("two-scale", model, {{"n_tau", 8}});
+        const Vector u =
+            tsi::test::solve(*model, *two_scale, *h.scheme(scheme->info.name, Json::object(), "klein-gordon"), 1.0, 8);
+        const auto exact = model->exact_solution()->at(model->to_physical(model->initial_value()), 1.0);
+        CAPTURE(wave.dump());
+        CAPTURE(eps);
+        CAPTURE(scheme->info.name);
+        CHECK(model->error_norm(u - exact.x) / model->error_norm(exact.x) < 1e-13 + 100.0 * exact.accuracy);
+      }
+  // With lambda != 0 there is no exact solution to declare.
+  Json cubic = waves[0];
+  cubic["lambda"] = 1.0;
+  CHECK(h.model_with("klein-gordon", 0.1, cubic)->exact_solution() == nullptr);
+}
+
+}  // namespace

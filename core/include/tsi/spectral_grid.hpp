@@ -2,6 +2,7 @@
 #include <array>
 #include <utility>
 #include <map>
+#include <optional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -177,6 +178,24 @@ class TSI_API GridTransformsPool {
 /// per direction `n_x`, `n_y`, `n_z` (even, 2 .. 2^20; n_y and n_z default to n_x). `what`
 /// says what a value on the grid is, for the documentation ("samples of u").
 TSI_API ParamSchema spectral_grid_params(const std::string& what);
+/// A plane wave a e^{i k.x} on a SpectralGrid, the data a model offers as `initial: "plane-wave"`.
+struct TSI_API PlaneWave {
+  double amplitude = 1.0;
+  std::array<int, 3> wave_vector{1, 0, 0};  ///< k, zero beyond the grid's dims
+  /// |k|^2.
+  double k2() const;
+  /// a e^{i k.x} at x.
+  Complex at(const std::array<double, 3>& x) const;
+};
+/// The parameters of a model's initial data on a SpectralGrid: `initial` (`default_name`,
+/// described by `default_doc`, or "plane-wave"), `wave_vector` and `amplitude` (the plane wave's).
+TSI_API ParamSchema initial_data_params(const std::string& default_name, const std::string& default_doc);
+/// The plane wave a model's resolved parameters ask for, or none for the default data: a
+/// ConfigError naming `model.wave_vector[i]` for a k_i that is no integer or not below n_i / 2
+/// in magnitude, `model.wave_vector` for the wrong count, and either key where the data are not
+/// the plane wave. Default k = (1, 0, 0), a = 1.
+TSI_API std::optional<PlaneWave> plane_wave(const Params& params, const std::vector<int>& shape);
+
 /// The grid's shape from a model's resolved parameters: a ConfigError naming `model.n_y` or
 /// `model.n_z` where one is given beyond `dims`, or where the grid has more than 2^31 - 1 points.
 TSI_API std::vector<int> spectral_grid_shape(const Params& params);

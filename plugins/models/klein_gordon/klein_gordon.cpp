@@ -44,13 +44,16 @@
 // modes, decaying like e^{-0.88 |k|} (k = 3, 5, 7: 0.11, 0.018, 0.003). Well prepared uniformly
 // in eps: e^2 z_t(0) = (1 - e^2 d_xx)^{1/2} of an eps-independent smooth function is O(1).
 // In 2-D and 3-D the products over the directions: z(x, 0) = prod_i cos x_i / (1 + sin^2 x_i),
-// and the momentum part (1/2) prod_i sin x_i / (1 + cos^2 x_i).
+// and the momentum part (1/2) prod_i sin x_i / (1 + cos^2 x_i). `initial: "plane-wave"` gives
+// v0 = a e^{i k.x} instead, an exact solution at lambda = 0 (v0 e^{i omega_k t}).
 #include <array>
 #include <cmath>
 #include <complex>
 #include <map>
 #include <memory>
+#include <limits>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -80,13 +83,17 @@ class KleinGordon final : public tsi::Model,
                           public tsi::HamiltonianStructure,
                           public tsi::FusedTauGrid,
                           public tsi::ExactNonlinearFlow,
-                          public tsi::PhysicalVariables {
+                          public tsi::PhysicalVariables,
+                          public tsi::ExactSolution {
  public:
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
-  KleinGordon(double eps, std::vector<int> shape, double lambda, tsi::ThreadLimit fftw_threads = {})
+  // wave: the plane wave of model.initial = "plane-wave", else none (the default data).
+  KleinGordon(double eps, std::vector<int> shape, double lambda, std::optional<tsi::PlaneWave> wave,
+              tsi::ThreadLimit fftw_threads = {})
       : Model(eps),
         grid_(std::move(shape)),
         n_x_(grid_.points()),
+        wave_(wave),
         lambda_(lambda),
         volume_(std::pow(tsi::two_pi, grid_.dims())),
         inverse_a_(n_x_),
@@ -112,6 +119,8 @@ class KleinGordon final : public tsi::Model,
   const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
   const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
   const tsi::ExactNonlinearFlow* exact_nonlinear_flow() const override { return this; }
+  // The linear equation's plane wave (lambda = 0) is exact.
+  const tsi::ExactSolution* exact_solution() const override { return wave_ && lambda_ == 0.0 ? this : nullptr; }
   const tsi::PhysicalVariables* physical_variables() const override { return this; }
 
   // e^{JM tau} = e^{i tau}: one phase for every coordinate.
@@ -223,6 +232,10 @@ class KleinGordon final : public tsi::Model,
   Vector initial_value() const override {
     Vector v(n_x_);
     grid_.for_each_point([&](Index j, const std::array<double, 3>& x) {
+      if (wave_) {
+        v(j) = wave_->at(x);
+        return;
+      }
       double z = 1.0, p = 1.0;  // the products over the directions
       for (int i = 0; i < grid_.dims(); ++i) {
         const double s = std::sin(x[static_cast<std::size_t>(i)]), co = std::cos(x[static_cast<std::size_t>(i)]);
@@ -232,6 +245,19 @@ class KleinGordon final : public tsi::Model,
       v(j) = Complex(z, -0.5 * p);
     });
     return from_physical(v);
+  }
+
+  // At lambda = 0 every mode turns alone, w_k' = i omega_k w_k with omega_k even in k, so the
+  // plane wave v0 = a e^{i k.x} (z = a cos k.x, a wave moving against k) is v0 e^{i omega_k t},
+  // omega_k = sqrt(1 + eps |k|^2) / eps. x0 must be that wave (model.u0 not given).
+  tsi::ExactSolution::Value at(const Vector& x0, double t) const override {
+    const Vector wave = to_physical(initial_value());
+    if ((x0 - wave).norm() > 1e-13 * std::max(1.0, wave.norm()))
+      throw tsi::Error("klein-gordon: the exact solution is the plane wave of model.initial = \"plane-wave\"; this "
+                       "run starts elsewhere (model.u0 given)");
+    const double omega = std::sqrt(1.0 + eps() * wave_->k2()) / eps();
+    const double rounding = std::numeric_limits<double>::epsilon();
+    return {x0 * std::polar(1.0, omega * t), std::max(rounding, 4.0 * rounding * std::abs(omega * t))};
   }
 
   Index physical_dim() const override { return n_x_; }
@@ -310,6 +336,7 @@ class KleinGordon final : public tsi::Model,
 
   tsi::SpectralGrid grid_;
   Index n_x_;       // the grid's points, N
+  std::optional<tsi::PlaneWave> wave_;
   double lambda_;
   double volume_;   // (2 pi)^d
   tsi::RealVector inverse_a_;  // a_k^{-1} = (1 + eps k^2)^{-1/4}
@@ -330,6 +357,9 @@ void register_klein_gordon(tsi::Registry& registry) {
       "nonlinear Klein-Gordon e^2 z_tt - lap z + z/e^2 + lambda z^3 = 0 on the torus [0, 2 pi)^dims, eps = e^2, "
       "Fourier in space, dim n_x [n_y [n_z]]";
   entry.info.params = tsi::spectral_grid_params("samples of v");
+  for (tsi::ParamSpec& spec : tsi::initial_data_params(
+           "default", "z = cos x / (1 + sin^2 x) and its momentum, products over the directions"))
+    entry.info.params.push_back(std::move(spec));
   entry.info.params.push_back(
       tsi::number_param("lambda", 1.0, "coefficient of the cubic term lambda z^3")
           .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number"));
@@ -341,8 +371,9 @@ void register_klein_gordon(tsi::Registry& registry) {
   // to h = 1/128 (order 0.90 over 1/16 .. 1/128, 1.74 over 1/64 .. 1/512).
   entry.verification = {{1.0, 1.0 / 256, 1e-4, 1e-6}, {16, 32, 64, 128}};
   entry.create = [](const tsi::Params& p) {
-    return std::make_unique<KleinGordon>(p.number("eps"), tsi::spectral_grid_shape(p), p.number("lambda"),
-                                         p.context().fft);
+    std::vector<int> shape = tsi::spectral_grid_shape(p);
+    const std::optional<tsi::PlaneWave> wave = tsi::plane_wave(p, shape);
+    return std::make_unique<KleinGordon>(p.number("eps"), std::move(shape), p.number("lambda"), wave, p.context().fft);
   };
   registry.add_model(std::move(entry));
 }

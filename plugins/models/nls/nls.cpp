@@ -32,6 +32,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -133,13 +134,6 @@ class Phases {
   std::array<Vector, 3> per_direction_;
 };
 
-/// The initial data a user picks (`model.initial`).
-struct InitialData {
-  bool plane_wave = false;  // else the paper's u0 (its product over the directions)
-  double amplitude = 1.0;
-  std::array<int, 3> wave_vector{0, 0, 0};
-};
-
 class Nls final : public tsi::Model,
                   public tsi::HamiltonianStructure,
                   public tsi::FusedTauGrid,
@@ -149,10 +143,12 @@ class Nls final : public tsi::Model,
  public:
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
   // dealias: the 2/3 rule on the field (and on u0), see the header.
-  Nls(double eps, std::vector<int> shape, InitialData initial, bool dealias, tsi::ThreadLimit fftw_threads = {})
+  // wave: the plane wave of model.initial = "plane-wave", else none (the paper's data).
+  Nls(double eps, std::vector<int> shape, std::optional<tsi::PlaneWave> wave, bool dealias,
+      tsi::ThreadLimit fftw_threads = {})
       : Model(eps),
         grid_(std::move(shape)),
-        initial_(initial),
+        wave_(wave),
         dealias_(dealias ? grid_.dealias_mask() : tsi::RealVector()),
         volume_(std::pow(tsi::two_pi, grid_.dims())),
         batches_(grid_, fftw_threads) {
@@ -167,7 +163,7 @@ class Nls final : public tsi::Model,
   // Dealiased, the field's flow is no longer u e^{-i |u|^2 t} on the grid.
   const tsi::ExactNonlinearFlow* exact_nonlinear_flow() const override { return dealias_.size() ? nullptr : this; }
   const tsi::PhysicalVariables* physical_variables() const override { return this; }
-  const tsi::ExactSolution* exact_solution() const override { return initial_.plane_wave ? this : nullptr; }
+  const tsi::ExactSolution* exact_solution() const override { return wave_ ? this : nullptr; }
 
   // e^{JM tau}: mode m times e^{-i |m|^2 tau} = prod_i e^{-i m_i^2 tau}.
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
@@ -379,11 +375,8 @@ class Nls final : public tsi::Model,
   Vector initial_value() const override {
     Vector x(grid_.points());
     grid_.for_each_point([&](Index p, const std::array<double, 3>& at) {
-      if (initial_.plane_wave) {
-        double phase = 0.0;
-        for (int i = 0; i < grid_.dims(); ++i)
-          phase += initial_.wave_vector[static_cast<std::size_t>(i)] * at[static_cast<std::size_t>(i)];
-        x(p) = std::polar(initial_.amplitude, phase);
+      if (wave_) {
+        x(p) = wave_->at(at);
         return;
       }
       // the paper's e^{ix} / (1 + sin^2 x), a factor per direction
@@ -401,11 +394,7 @@ class Nls final : public tsi::Model,
     if ((x0 - wave).norm() > 1e-13 * std::max(1.0, wave.norm()))
       throw tsi::Error("nls: the exact solution is the plane wave of model.initial = \"plane-wave\"; this run "
                        "starts elsewhere (model.u0 given)");
-    double k2 = 0.0;
-    for (int i = 0; i < grid_.dims(); ++i)
-      k2 += static_cast<double>(initial_.wave_vector[static_cast<std::size_t>(i)]) *
-            initial_.wave_vector[static_cast<std::size_t>(i)];
-    const double frequency = k2 / eps() + initial_.amplitude * initial_.amplitude;
+    const double frequency = wave_->k2() / eps() + wave_->amplitude * wave_->amplitude;
     // The phase is rounded to a few ulp of frequency * t, as the schemes' own e^{-i |m|^2 t / eps}.
     const double rounding = std::numeric_limits<double>::epsilon();
     return {x0 * std::polar(1.0, -frequency * t), std::max(rounding, 4.0 * rounding * std::abs(frequency * t))};
@@ -476,43 +465,13 @@ class Nls final : public tsi::Model,
   }
 
   tsi::SpectralGrid grid_;
-  InitialData initial_;
+  std::optional<tsi::PlaneWave> wave_;
   tsi::RealVector dealias_;    // the 2/3 rule's mask, or empty
   double volume_;              // (2 pi)^d
   mutable std::mutex mutex_;   // the batches' buffers and phases_ are shared work space
   mutable tsi::GridTransformsPool batches_;
   mutable Phases phases_{grid_};
 };
-
-InitialData initial_data(const tsi::Params& p, const std::vector<int>& shape) {
-  InitialData data;
-  data.plane_wave = p.string("initial") == "plane-wave";
-  const int dims = static_cast<int>(shape.size());
-  if (!data.plane_wave) {
-    for (const char* key : {"wave_vector", "amplitude"})
-      if (p.has(key))
-        throw tsi::ConfigError(std::string("model.") + key, "is given, but model.initial is \"" + p.string("initial") +
-                                                                "\" (it belongs to \"plane-wave\")");
-    return data;
-  }
-  if (p.has("amplitude")) data.amplitude = p.number("amplitude");
-  data.wave_vector[0] = 1;  // the default: e^{ix}
-  if (!p.has("wave_vector")) return data;
-  const tsi::Json& k = p.raw().at("wave_vector");
-  if (static_cast<int>(k.size()) != dims)
-    throw tsi::ConfigError("model.wave_vector", "got " + k.dump() + ", expected " + std::to_string(dims) +
-                                                    " integers (one per direction, dims = " + std::to_string(dims) + ")");
-  for (int i = 0; i < dims; ++i) {
-    const tsi::Json& v = k.at(static_cast<std::size_t>(i));
-    const int n = shape[static_cast<std::size_t>(i)];
-    // Resolved on the grid: |k_i| < n_i / 2 (the Nyquist mode has no sign).
-    if (!v.is_number_integer() || std::abs(v.get<long>()) >= n / 2)
-      throw tsi::ConfigError("model.wave_vector[" + std::to_string(i) + "]",
-                             "got " + v.dump() + ", expected an integer of magnitude below n/2 = " + std::to_string(n / 2));
-    data.wave_vector[static_cast<std::size_t>(i)] = static_cast<int>(v.get<long>());
-  }
-  return data;
-}
 
 void register_nls(tsi::Registry& registry) {
   tsi::ModelEntry entry;
@@ -521,16 +480,9 @@ void register_nls(tsi::Registry& registry) {
       "cubic NLS i u_t = -(1/eps) lap u + |u|^2 u on the torus [0, 2 pi)^dims (eq. NLS eq), Fourier in space, "
       "dim n_x [n_y [n_z]]";
   entry.info.params = tsi::spectral_grid_params("samples of u");
-  entry.info.params.push_back(
-      tsi::string_param("initial", "paper",
-                        "initial data: \"paper\" (e^{ix} / (1 + sin^2 x), its product over the directions) or "
-                        "\"plane-wave\" (amplitude e^{i k.x}, with an exact solution)")
-          .choices({"paper", "plane-wave"}));
-  entry.info.params.push_back(
-      tsi::array_param("wave_vector", "the plane wave's k, one integer per direction with |k_i| < n_i/2; default (1, 0, 0)"));
-  entry.info.params.push_back(
-      tsi::number_param("amplitude", nullptr, "the plane wave's amplitude a; default 1")
-          .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number"));
+  for (tsi::ParamSpec& spec :
+       tsi::initial_data_params("paper", "e^{ix} / (1 + sin^2 x), its product over the directions"))
+    entry.info.params.push_back(std::move(spec));
   entry.info.params.push_back(tsi::bool_param(
       "dealias", false,
       "the 2/3 rule: the field's modes with some |m_i| > n_i/3 set to zero, and u0's too (the run stays in the "
@@ -540,8 +492,8 @@ void register_nls(tsi::Registry& registry) {
   entry.verification = {{1.0, 1.0 / 16, 1.0 / 256}, {4, 8, 16, 32}};
   entry.create = [](const tsi::Params& p) {
     std::vector<int> shape = tsi::spectral_grid_shape(p);
-    const InitialData initial = initial_data(p, shape);
-    return std::make_unique<Nls>(p.number("eps"), std::move(shape), initial, p.boolean("dealias"), p.context().fft);
+    const std::optional<tsi::PlaneWave> wave = tsi::plane_wave(p, shape);
+    return std::make_unique<Nls>(p.number("eps"), std::move(shape), wave, p.boolean("dealias"), p.context().fft);
   };
   registry.add_model(std::move(entry));
 }
