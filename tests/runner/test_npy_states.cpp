@@ -169,6 +169,33 @@ np.save('hh.npy', np.array([[0.12, 0.12], [0.12, 0.12]]))
          dir.path());
 }
 
+TEST_CASE("npy states: a 2-D grid's states are (n_x, n_y) arrays, from u0's file and without one") {
+  // 2-D NLS on 8 x 6 points, u0 a plane wave of modulus 0.5 as an (8, 6) array: u_final.npy and
+  // the reference's have the grid's shape, with a file or without (the model's physical shape),
+  // and the run keeps the modulus (the plane wave turns in place).
+  t::TempDir dir("tsi-npy-grid");
+  python(R"py(
+x = np.arange(8) * 2 * np.pi / 8
+y = np.arange(6) * 2 * np.pi / 6
+np.save('u0.npy', 0.5 * np.exp(1j * x)[:, None] * np.exp(-2j * y)[None, :])
+)py",
+         dir.path());
+  t::Json config = nls_config(8);
+  config["model"]["dims"] = 2;
+  config["model"]["n_y"] = 6;
+  config["model"]["u0"] = "u0.npy";
+  const t::CommandResult r = t::run_tsi({"run", t::write_config(dir, config), "--out", dir / "out"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  CHECK(tsi::read_npy_header(dir / "out/u_final.npy").shape == std::vector<std::uint64_t>{8, 6});
+  CHECK(tsi::read_npy_header(dir / "out/reference_u_final.npy").shape == std::vector<std::uint64_t>{8, 6});
+  python("u = np.load('out/u_final.npy')\nassert u.shape == (8, 6)\nassert abs(abs(u) - 0.5).max() < 1e-10", dir.path());
+  config["model"].erase("u0");
+  const t::CommandResult plain = t::run_tsi({"run", t::write_config(dir, config), "--out", dir / "plain"});
+  REQUIRE(plain.exit_code == 0);
+  CHECK(tsi::read_npy_header(dir / "plain/u_final.npy").shape == std::vector<std::uint64_t>{8, 6});
+}
+
 TEST_CASE("npy states: a run that stops part-way writes u_final.npy of its last state, a stale reference file goes") {
   t::TempDir dir("tsi-npy-run");
   t::Json config = hh_config();
