@@ -14,6 +14,47 @@
 
 namespace tsi {
 
+namespace detail {
+
+// A large multi-dimensional field (from 4096 points) goes one direction at a time: the last
+// (contiguous) by its own plan, the others here, through FftBatch's blocks of a few rows at a
+// time (in cache): FFTW_ESTIMATE's plan for a whole 256 x 256 field walks it once per strided
+// transform, 2.9 ms against 0.2 ms. Small fields and every 1-D grid: one batched plan. On one
+// thread: FFTW's threads would split the strided plans (no blocks), slower here than one thread
+// (125 ms against 62 at 256 x 256 x 32); a run's threads split its tau grid.
+class LeadingDirections {
+ public:
+  static constexpr Index min_points = 4096;
+  static bool used_for(const SpectralGrid& grid) { return grid.dims() > 1 && grid.points() >= min_points; }
+
+  // The directions before the last of a field whose last direction holds `last_width` values
+  // (n_d complex values, or n_d/2 + 1 of a real field's half spectrum).
+  LeadingDirections(const std::vector<int>& shape, int last_width) {
+    const std::size_t last = shape.size() - 1;
+    points_ = last_width;
+    for (std::size_t i = 0; i < last; ++i) points_ *= shape[i];
+    for (std::size_t i = 0; i < last; ++i) {  // direction i: n_i points, stride and count the rest
+      int inner = last_width;
+      for (std::size_t k = i + 1; k < last; ++k) inner *= shape[k];
+      batches_.push_back(std::make_unique<FftBatch>(shape[i], inner));
+      slabs_.push_back(static_cast<Index>(shape[i]) * inner);  // the field is points / slab such slabs
+    }
+  }
+
+  // The field at `field` along every leading direction, innermost first: forward (0) or backward (1).
+  void transform(Complex* field, int direction) {
+    for (std::size_t i = batches_.size(); i-- > 0;)
+      for (Index at = 0; at < points_; at += slabs_[i]) batches_[i]->transform(field + at, field + at, direction);
+  }
+
+ private:
+  Index points_ = 1;
+  std::vector<std::unique_ptr<FftBatch>> batches_;
+  std::vector<Index> slabs_;
+};
+
+}  // namespace detail
+
 SpectralGrid::SpectralGrid(std::vector<int> shape) : shape_(std::move(shape)) {
   if (shape_.empty() || shape_.size() > 3)
     throw Error(fmt::format("SpectralGrid: {} directions given, expected 1, 2 or 3", shape_.size()));
@@ -128,31 +169,19 @@ GridTransforms::GridTransforms(const SpectralGrid& grid, Index columns, ThreadLi
     throw Error(fmt::format("GridTransforms: {} columns, expected 1 to 2^31 - 1", columns));
   const auto values = static_cast<std::size_t>(points_) * static_cast<std::size_t>(columns_);
   const std::vector<int>& shape = grid.shape();
-  // A large multi-dimensional field goes one direction at a time: the last (contiguous) by a
-  // plan for its rows, the others through FftBatch's blocks of a few rows at a time (in cache):
-  // FFTW_ESTIMATE's plan for a whole 256 x 256 field walks it once per strided transform, 2.9 ms
-  // against 0.2 ms. Small fields and every 1-D grid: one batched plan over all columns.
-  by_direction_ = grid.dims() > 1 && points_ >= by_direction_points;
-  if (by_direction_) {
-    for (int i = 0; i + 1 < grid.dims(); ++i) {  // direction i: n_i points, stride and count the rest
-      int inner = 1;
-      for (int k = i + 1; k < grid.dims(); ++k) inner *= shape[static_cast<std::size_t>(k)];
-      // On one thread: FFTW's threads would split the strided plans (no blocks), slower here
-      // than one thread (125 ms against 62 at 256 x 256 x 32); a run's threads split its tau grid.
-      strided_.push_back(std::make_unique<FftBatch>(shape[static_cast<std::size_t>(i)], inner));
-    }
-  }
+  if (detail::LeadingDirections::used_for(grid))  // by direction; the last one by the plans below
+    leading_ = std::make_unique<detail::LeadingDirections>(shape, shape.back());
   std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
   buffer_ = reinterpret_cast<Complex*>(fftw_alloc_complex(values));
   if (!buffer_)
     throw Error(fmt::format("GridTransforms: cannot allocate {} x {} complex values ({:.3g} GB)", grid.describe(),
                             columns, 16.0 * static_cast<double>(values) / 1e9));
   if (detail::fftw_threads_ready())
-    fftw_plan_with_nthreads(by_direction_ ? 1 : fftw_threads.for_size(static_cast<Index>(values)));
+    fftw_plan_with_nthreads(leading_ ? 1 : fftw_threads.for_size(static_cast<Index>(values)));
   auto* data = reinterpret_cast<fftw_complex*>(buffer_);
   const int signs[2] = {FFTW_FORWARD, FFTW_BACKWARD};
   for (int d = 0; d < 2; ++d) {
-    if (by_direction_) {  // the last direction of one field: points / n_last rows of n_last
+    if (leading_) {  // the last direction of one field: points / n_last rows of n_last
       const int n_last = shape.back();
       plans_[d] = fftw_plan_many_dft(1, &n_last, static_cast<int>(points_ / n_last), data, nullptr, 1, n_last, data,
                                      nullptr, 1, n_last, signs[d], FFTW_ESTIMATE);
@@ -170,16 +199,10 @@ GridTransforms::GridTransforms(const SpectralGrid& grid, Index columns, ThreadLi
     throw Error(fmt::format("GridTransforms: FFTW could not plan {} x {} transforms", grid.describe(), columns));
   }
   std::fill(buffer_, buffer_ + values, Complex(0.0));
-  if (by_direction_)
-    for (int i = 0; i + 1 < grid.dims(); ++i) {
-      int slab = 1;  // the field is points / slab slabs, each transformed along direction i
-      for (int k = i; k < grid.dims(); ++k) slab *= shape[static_cast<std::size_t>(k)];
-      slabs_.push_back(slab);
-    }
 }
 
 GridTransforms::~GridTransforms() {
-  strided_.clear();  // before the lock: FftBatch takes it itself
+  leading_.reset();  // before the lock: FftBatch takes it itself
   std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
   for (void* plan : plans_)
     if (plan) fftw_destroy_plan(static_cast<fftw_plan>(plan));
@@ -188,13 +211,12 @@ GridTransforms::~GridTransforms() {
 
 void GridTransforms::execute(int direction) {
   auto* plan = static_cast<fftw_plan>(plans_[direction]);
-  if (!by_direction_) return fftw_execute(plan);
+  if (!leading_) return fftw_execute(plan);
   // Every column has the buffer's alignment (points_ even, 16-byte complex values).
   for (Index j = 0; j < columns_; ++j) {
     Complex* field = buffer_ + j * points_;
     fftw_execute_dft(plan, reinterpret_cast<fftw_complex*>(field), reinterpret_cast<fftw_complex*>(field));
-    for (std::size_t i = strided_.size(); i-- > 0;)  // the directions before the last, innermost first
-      for (Index at = 0; at < points_; at += slabs_[i]) strided_[i]->transform(field + at, field + at, direction);
+    leading_->transform(field, direction);
   }
 }
 
@@ -212,17 +234,8 @@ RealGridTransforms::RealGridTransforms(const SpectralGrid& grid, Index columns, 
     throw Error(fmt::format("RealGridTransforms: {} columns, expected 1 to 2^31 - 1", columns));
   const std::vector<int>& shape = grid.shape();
   const int half = n_last_ / 2 + 1;
-  by_direction_ = grid.dims() > 1 && points_ >= by_direction_points;
-  if (by_direction_)  // the leading directions of the half spectrum, complex, through FftBatch
-    for (int i = 0; i + 1 < grid.dims(); ++i) {
-      int inner = half, slab = half * shape[static_cast<std::size_t>(i)];
-      for (int k = i + 1; k + 1 < grid.dims(); ++k) {
-        inner *= shape[static_cast<std::size_t>(k)];
-        slab *= shape[static_cast<std::size_t>(k)];
-      }
-      strided_.push_back(std::make_unique<FftBatch>(shape[static_cast<std::size_t>(i)], inner));
-      slabs_.push_back(slab);
-    }
+  if (detail::LeadingDirections::used_for(grid))  // the half spectrum's, complex; the last by the plans below
+    leading_ = std::make_unique<detail::LeadingDirections>(shape, half);
   const auto n_values = static_cast<std::size_t>(points_) * static_cast<std::size_t>(columns_);
   const auto n_coefficients = static_cast<std::size_t>(half_points_) * static_cast<std::size_t>(columns_);
   std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
@@ -240,9 +253,9 @@ RealGridTransforms::RealGridTransforms(const SpectralGrid& grid, Index columns, 
                             columns, 16.0 * static_cast<double>(n_values) / 1e9));
   }
   if (detail::fftw_threads_ready())
-    fftw_plan_with_nthreads(by_direction_ ? 1 : fftw_threads.for_size(static_cast<Index>(n_values)));
+    fftw_plan_with_nthreads(leading_ ? 1 : fftw_threads.for_size(static_cast<Index>(n_values)));
   auto* out = reinterpret_cast<fftw_complex*>(spectrum_);
-  if (by_direction_) {  // the last direction of one field: its rows
+  if (leading_) {  // the last direction of one field: its rows
     const int rows = static_cast<int>(points_ / n_last_);
     plans_[0] = fftw_plan_many_dft_r2c(1, &n_last_, rows, values_, nullptr, 1, n_last_, out, nullptr, 1, half,
                                        FFTW_ESTIMATE);
@@ -265,7 +278,7 @@ RealGridTransforms::RealGridTransforms(const SpectralGrid& grid, Index columns, 
 }
 
 RealGridTransforms::~RealGridTransforms() {
-  strided_.clear();  // before the lock: FftBatch takes it itself
+  leading_.reset();  // before the lock: FftBatch takes it itself
   std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
   for (void* plan : plans_)
     if (plan) fftw_destroy_plan(static_cast<fftw_plan>(plan));
@@ -275,23 +288,21 @@ RealGridTransforms::~RealGridTransforms() {
 
 void RealGridTransforms::forward() {
   auto* plan = static_cast<fftw_plan>(plans_[0]);
-  if (!by_direction_) return fftw_execute(plan);
+  if (!leading_) return fftw_execute(plan);
   for (Index j = 0; j < columns_; ++j) {
     Complex* field = spectrum_ + j * half_points_;
     // Columns keep the buffers' alignment: points_ even (doubles) and 16-byte complex values.
     fftw_execute_dft_r2c(plan, values_ + j * points_, reinterpret_cast<fftw_complex*>(field));
-    for (std::size_t i = strided_.size(); i-- > 0;)
-      for (Index at = 0; at < half_points_; at += slabs_[i]) strided_[i]->transform(field + at, field + at, 0);
+    leading_->transform(field, 0);
   }
 }
 
 void RealGridTransforms::backward() {
   auto* plan = static_cast<fftw_plan>(plans_[1]);
-  if (!by_direction_) return fftw_execute(plan);
+  if (!leading_) return fftw_execute(plan);
   for (Index j = 0; j < columns_; ++j) {
     Complex* field = spectrum_ + j * half_points_;
-    for (std::size_t i = 0; i < strided_.size(); ++i)
-      for (Index at = 0; at < half_points_; at += slabs_[i]) strided_[i]->transform(field + at, field + at, 1);
+    leading_->transform(field, 1);
     fftw_execute_dft_c2r(plan, reinterpret_cast<fftw_complex*>(field), values_ + j * points_);
   }
 }

@@ -9,11 +9,14 @@
 
 #include "tsi/context.hpp"
 #include "tsi/export.hpp"
-#include "tsi/fft.hpp"
 #include "tsi/params.hpp"
 #include "tsi/types.hpp"
 
 namespace tsi {
+
+namespace detail {
+class LeadingDirections;  // a large field's directions before the last, by FftBatch's blocks
+}
 
 /// The periodic grid of a pseudo-spectral model in 1, 2 or 3 dimensions: n_1 x .. x n_d points
 /// on [0, 2 pi)^d, x = 2 pi (j_1 / n_1, .., j_d / n_d), each n_i even. A field on it is a
@@ -109,13 +112,10 @@ class TSI_API GridTransforms {
 
  private:
   void execute(int direction);
-  static constexpr Index by_direction_points = 4096;
   Index points_, columns_;
-  bool by_direction_ = false;
   Complex* buffer_ = nullptr;
-  std::vector<std::unique_ptr<FftBatch>> strided_;  // directions 1 .. d-1 of a field, by blocks
-  std::vector<Index> slabs_;                         // points per slab of each of them
-  void* plans_[2] = {nullptr, nullptr};  // forward, backward
+  std::unique_ptr<detail::LeadingDirections> leading_;  // a large multi-dimensional field: by direction
+  void* plans_[2] = {nullptr, nullptr};                  // forward, backward
   Matrix scratch_;
 };
 
@@ -146,15 +146,12 @@ class TSI_API RealGridTransforms {
   Index columns() const { return columns_; }
 
  private:
-  static constexpr Index by_direction_points = 4096;
   Index points_, half_points_, columns_;
   int n_last_;
-  bool by_direction_ = false;
   double* values_ = nullptr;
   Complex* spectrum_ = nullptr;
-  void* plans_[2] = {nullptr, nullptr};              // r2c, c2r
-  std::vector<std::unique_ptr<FftBatch>> strided_;  // by direction: the leading directions
-  std::vector<Index> slabs_;
+  std::unique_ptr<detail::LeadingDirections> leading_;  // a large multi-dimensional field: by direction
+  void* plans_[2] = {nullptr, nullptr};                  // r2c, c2r
   RealMatrix scratch_;
 };
 
