@@ -166,7 +166,7 @@ Vector final_model_state(Assembly& a, double t_end, long steps, const ProgressFn
       last_progress = Clock::now();
     }
     return true;
-  });
+  }, a.reformulation->repreparation());
   return a.reformulation->read_back(y, t_end);
 }
 
@@ -471,7 +471,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
       }
       if (go_on && !stream_dir.empty() && seconds_since(last_checkpoint) > checkpoint_seconds) checkpoint(n, t);
       return go_on;
-    });
+    }, reformulation->repreparation());
     if (status == "completed" && recorder.status() != "running") {
       status = recorder.status();
       outcome.message = recorder.message();

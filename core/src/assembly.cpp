@@ -11,6 +11,7 @@
 #include <string>
 
 #include "tsi/error.hpp"
+#include "tsi/fft.hpp"
 #include "tsi/npy.hpp"
 #include "reformulations/two_scale.hpp"
 
@@ -69,7 +70,8 @@ double available_bytes() {
 }  // namespace
 
 Footprint two_scale_footprint(const Model& model, const Json& reformulation, const Scheme& scheme,
-                              const std::string& scheme_name, bool bound_before_preparation) {
+                              const std::string& scheme_name, bool bound_before_preparation,
+                              const Context& context) {
   Footprint f;
   if (!reformulation.contains("n_tau") || !reformulation["n_tau"].is_number()) return f;
   f.dim = static_cast<double>(model.dim());
@@ -99,6 +101,13 @@ Footprint two_scale_footprint(const Model& model, const Json& reformulation, con
     // holds the real grid and, where its binding does not evaluate in place, the real field.
     f.preparation_vectors *= f.n_tau / modes;
     f.problem_vectors = 2.0;
+  } else {
+    // The complex layout's tau transforms: a batch that is not buffered (fewer than 32 tau
+    // points or unknowns, or split by FFTW's threads) holds a whole grid, one state more.
+    const Index values = static_cast<Index>(std::min(f.dim * f.n_tau, 9e18));
+    const bool split = context.fft.for_size(values) > 1;
+    if (f.dim < 2147483647.0 && !FftBatch::buffers(static_cast<int>(f.n_tau), static_cast<int>(f.dim), split))
+      f.problem_vectors += 1.0;
   }
   // A run prepares its data before it binds the scheme (the preparation's grids are freed by
   // then); bound first, both are held at once.
@@ -282,7 +291,8 @@ Assembly assemble(const Json& resolved, const Registry& registry, const Assembly
   a.scheme = a.scheme_entry->create(Params(without_name(resolved["scheme"]), options.context));
   const bool binds = options.bind && resolved.contains("time") && resolved["time"].contains("h") &&
                      resolved["time"]["h"].is_number();
-  a.footprint = two_scale_footprint(*a.model, resolved["reformulation"], *a.scheme, a.scheme_entry->info.name, binds);
+  a.footprint = two_scale_footprint(*a.model, resolved["reformulation"], *a.scheme, a.scheme_entry->info.name, binds,
+                                    options.context);
   check_footprint(a.footprint, options.memory_bytes);
   a.reformulation = a.reformulation_entry->create(a.model, Params(without_name(resolved["reformulation"]), options.context));
   const StepperTraits& traits = a.traits;

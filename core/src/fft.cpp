@@ -38,6 +38,10 @@ fftw_plan as_plan(void* p) { return static_cast<fftw_plan>(p); }
 fftw_complex* raw(Complex* p) { return reinterpret_cast<fftw_complex*>(p); }
 }  // namespace
 
+bool FftBatch::buffers(int n, int howmany, bool fftw_split) {
+  return !fftw_split && howmany >= buffered_min_rows && n >= buffered_min_points && n % 2 == 0;
+}
+
 FftBatch::FftBatch(int n, int howmany, int parts, ThreadLimit fftw_threads) : n_(n), howmany_(howmany) {
   if (n <= 0 || howmany <= 0) throw Error("FftBatch: sizes must be positive");
   if (parts < 1 || parts > howmany) throw Error("FftBatch: parts must be from 1 to the number of rows");
@@ -53,7 +57,7 @@ FftBatch::FftBatch(int n, int howmany, int parts, ThreadLimit fftw_threads) : n_
   // FFTW's own threads (tsi --fft-threads) split the strided plans; otherwise large batches
   // are buffered.
   // n even: every row of a block then has the block's alignment, as fftw_execute_dft needs.
-  const bool buffered = !fftw_split && howmany >= buffered_min_rows && n >= buffered_min_points && n % 2 == 0;
+  const bool buffered = buffers(n, howmany, fftw_split);
   if (!buffered) {  // the strided plans are made on the buffer itself
     buffer_ = reinterpret_cast<Complex*>(fftw_alloc_complex(static_cast<size_t>(n) * howmany));
     if (!buffer_)

@@ -316,7 +316,7 @@ void ModelChecks::interface(double eps) {
 Vector ModelChecks::reference(std::shared_ptr<const Model> m, const Vector& u0, double tol) const {
   Assembly a = assembly(registry_.scheme("rk78", "reference.scheme"), "filtered", m->eps(), tol, 200);
   Vector y = a.reformulation->prepare(u0);
-  integrate(a.bind(t_end), y, 1, {});
+  integrate(a.bind(t_end), y, 1, {}, a.reformulation->repreparation());
   return a.reformulation->read_back(y, t_end);
 }
 
@@ -341,7 +341,7 @@ std::vector<double> ModelChecks::errors(const SchemeEntry& scheme, double eps, c
     Vector y = a.reformulation->prepare(a.u0);
     double error = std::numeric_limits<double>::quiet_NaN();
     try {
-      integrate(a.bind(h), y, n, {});
+      integrate(a.bind(h), y, n, {}, a.reformulation->repreparation());
       const Vector x = a.model->to_physical(a.reformulation->read_back(y, step_time(n, h)));
       error = a.model->error_norm(x - x_ref) / a.model->error_norm(x_ref);
     } catch (const Error&) {

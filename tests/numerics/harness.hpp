@@ -112,7 +112,7 @@ inline std::vector<const SchemeEntry*> second_order_schemes() {
 inline Vector solve(const Model& model, Reformulation& reformulation, const Scheme& scheme, double t_end, long n) {
   Vector y = reformulation.prepare(model.initial_value());
   const double h = t_end / static_cast<double>(n);
-  integrate(*scheme.bind(reformulation, h), y, n, {});
+  integrate(*scheme.bind(reformulation, h), y, n, {}, reformulation.repreparation());
   return model.to_physical(reformulation.read_back(y, step_time(n, h)));
 }
 

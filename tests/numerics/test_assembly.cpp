@@ -26,7 +26,7 @@ Vector se2_solution(const Json& nodes, long steps) {
   auto a = Harness::instance().assemble(config);
   Vector y = a.reformulation->prepare(a.u0);
   const double h = 1.0 / static_cast<double>(steps);
-  tsi::integrate(a.bind(h), y, steps, {});
+  tsi::integrate(a.bind(h), y, steps, {}, a.reformulation->repreparation());
   return a.model->to_physical(a.reformulation->read_back(y, tsi::step_time(steps, h)));
 }
 

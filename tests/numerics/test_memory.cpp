@@ -11,6 +11,7 @@
 #include "harness.hpp"
 #include "tsi/assembly.hpp"
 #include "tsi/error.hpp"
+#include "tsi/fft.hpp"
 
 namespace {
 
@@ -124,4 +125,28 @@ TEST_CASE("memory: the footprint check counts the bound scheme's vectors and ref
   // The same limit admits SE1, whose footprint is smaller.
   CHECK(se1.bytes() < options.memory_bytes);
   CHECK(tsi::assemble_config(nls_config("se1"), h.registry(), options).reformulation != nullptr);
+}
+
+TEST_CASE("memory: the footprint counts the whole grid that unbuffered tau transforms hold") {
+  // The complex layout's tau transforms go through small blocks from 32 tau points and 32
+  // unknowns on; below that (or split by FFTW's threads) the batch holds a dim x n_tau buffer.
+  auto& h = Harness::instance();
+  const auto footprint = [&](long n_tau, int fft_threads) {
+    tsi::AssemblyOptions options;
+    options.bind = false;
+    options.context = tsi::Context::with_threads(1, fft_threads);
+    options.context.fft.min_values = 0;
+    return tsi::assemble_config(nls_config("se1", 128, n_tau), h.registry(), options).footprint;
+  };
+  CHECK(tsi::FftBatch::buffers(32, 128));
+  CHECK_FALSE(tsi::FftBatch::buffers(16, 128));
+  CHECK_FALSE(tsi::FftBatch::buffers(32, 16));
+  CHECK_FALSE(tsi::FftBatch::buffers(32, 128, true));
+  // The buffer's presence, as the batch itself reports it.
+  CHECK(tsi::FftBatch(32, 128).buffered());
+  CHECK_FALSE(tsi::FftBatch(16, 128).buffered());
+  const tsi::Footprint small = footprint(16, 1), large = footprint(32, 1), split = footprint(32, 2);
+  CHECK(small.problem_vectors == doctest::Approx(large.problem_vectors + 1.0));
+  // With FFTW's threads the batch is strided wherever they are set up: counted, an upper bound.
+  CHECK(split.problem_vectors == doctest::Approx(large.problem_vectors + 1.0));
 }

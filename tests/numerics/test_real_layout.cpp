@@ -114,7 +114,8 @@ TEST_CASE("real layout: re-preparation and the tau monitors read the real layout
     const double t = tsi::step_time(n, hstep);
     sr.step(tsi::step_time(n - 1, hstep), yr);
     sc.step(tsi::step_time(n - 1, hstep), yc);
-    const bool a = real.reformulation->between_steps(n, t, yr), b = complex.reformulation->between_steps(n, t, yc);
+    const bool a = real.reformulation->repreparation()->after_step(n, t, yr),
+               b = complex.reformulation->repreparation()->after_step(n, t, yc);
     REQUIRE(a == b);
     if (a) {
       ++repreparations;

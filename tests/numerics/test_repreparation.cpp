@@ -30,7 +30,7 @@ double error_at_one(const std::string& model, const std::string& scheme, double 
   auto a = Harness::instance().assemble(config(model, scheme, eps, reprepare));
   Vector y = a.reformulation->prepare(a.u0);
   const double h = 1.0 / static_cast<double>(steps);
-  tsi::integrate(a.bind(h), y, steps, {});
+  tsi::integrate(a.bind(h), y, steps, {}, a.reformulation->repreparation());
   const Vector x = a.model->to_physical(a.reformulation->read_back(y, tsi::step_time(steps, h)));
   const Vector& ref = tsi::test::reference_solution(model, eps, 1.0);
   return a.model->error_norm(x - ref) / a.model->error_norm(ref);
@@ -48,7 +48,7 @@ TEST_CASE("re-preparation: U(t_n, s_n) = v_n exactly, so the solution read back 
       const double h = 0.3;
       a.bind(h).step(0.0, y);
       const Vector before = a.reformulation->read_back(y, h), stepped = y;
-      CHECK(a.reformulation->between_steps(1, h, y));
+      CHECK(a.reformulation->repreparation()->after_step(1, h, y));
       const Vector after = a.reformulation->read_back(y, h);
       CAPTURE(model);
       CAPTURE(order);
@@ -95,7 +95,7 @@ TEST_CASE("re-preparation: NLS at eps = 0.1 keeps its mass over T = 200 where th
     tsi::integrate(a.bind(0.125), y, 1600, [&](long, double t, const Vector& state) {
       worst = std::max(worst, std::abs(a.model->mass(a.reformulation->read_back(state, t)) - m0) / m0);
       return true;
-    });
+    }, a.reformulation->repreparation());
     return worst;
   };
   const double never = max_mass_error("never"), every = max_mass_error(80), automatic = max_mass_error("auto");
@@ -120,7 +120,7 @@ TEST_CASE("re-preparation: auto brings the charged particle at eps = 1 below 1e-
     tsi::integrate(a.bind(h), y, steps, [&](long, double t, const Vector& state) {
       worst = std::max(worst, std::abs(a.model->energy(a.reformulation->read_back(state, t)) - e0) / std::abs(e0));
       return std::isfinite(worst) && worst < 10.0;
-    });
+    }, a.reformulation->repreparation());
     *repreparations = static_cast<long>(a.reformulation->two_scale_diagnostics()->repreparation_times().size());
     return worst;
   };

@@ -46,9 +46,11 @@ struct TSI_API AssemblyOptions {
 };
 
 /// The footprint of a two-scale run of `model` with these resolved reformulation parameters
-/// and this scheme (bound before or after the preparation of the data).
+/// and this scheme (bound before or after the preparation of the data), in this context (FFTW's
+/// threads decide whether the tau transforms hold a whole grid of their own).
 TSI_API Footprint two_scale_footprint(const Model& model, const Json& reformulation, const Scheme& scheme,
-                                      const std::string& scheme_name, bool bound_before_preparation);
+                                      const std::string& scheme_name, bool bound_before_preparation,
+                                      const Context& context = {});
 
 /// The objects of a run, built from a resolved selection.
 struct TSI_API Assembly {

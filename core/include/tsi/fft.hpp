@@ -57,6 +57,10 @@ class TSI_API FftBatch {
   int howmany() const { return howmany_; }
   /// True when the batch goes through the contiguous buffers (see above).
   bool buffered() const { return !blocks_.empty(); }
+  /// True when a batch of these sizes goes through the small buffers; false when it holds a
+  /// whole howmany x n buffer (the memory of a run: a vector of the state's size more).
+  /// `fftw_split`: FFTW's own threads split its transforms (they then go strided).
+  static bool buffers(int n, int howmany, bool fftw_split = false);
 
  private:
   /// The buffer, allocated (and zeroed) on first use.

@@ -69,11 +69,6 @@ class TSI_API Problem {
   /// y <- the exact flow of y' = N(t, y) from t to t + h. The default throws tsi::Error.
   virtual void nonlinear_flow(double t, double h, Vector& y);
 
-  /// Called by the driver after step n (state y at t_n): a problem may rebuild its state here
-  /// without changing the solution it represents (two-scale re-preparation). True when it did:
-  /// the driver then restarts the stepper (reset()), as a multistep scheme must.
-  virtual bool between_steps(long /*n*/, double /*t*/, Vector& /*y*/) { return false; }
-
   /// Evaluations of N (or of rhs) since construction: the work measure of a run.
   long evaluations() const { return evaluations_; }
 

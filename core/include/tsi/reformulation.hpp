@@ -4,6 +4,7 @@
 
 #include "tsi/export.hpp"
 #include "tsi/model.hpp"
+#include "tsi/observer.hpp"
 #include "tsi/problem.hpp"
 
 namespace tsi {
@@ -40,6 +41,9 @@ class TSI_API Reformulation : public Problem {
   virtual Vector read_back(const Vector& y, double t) = 0;
   /// The two-scale diagnostics (null for the filtered and direct problems, which have no tau).
   virtual const TwoScaleDiagnostics* two_scale_diagnostics() const { return nullptr; }
+  /// The observer that re-prepares the state between steps (two-scale; SPEC.md section 6),
+  /// to be given to tsi::integrate; null for the filtered and direct problems.
+  virtual StateObserver* repreparation() { return nullptr; }
 
   const Model& model() const { return *model_; }
 

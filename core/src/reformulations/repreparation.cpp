@@ -6,7 +6,7 @@
 
 namespace tsi {
 
-bool Repreparer::between_steps(long n, double t, Vector& y) {
+bool Repreparer::after_step(long n, double t, Vector& y) {
   if (rule_.mode == Repreparation::Mode::Never) return false;
   if (rule_.mode == Repreparation::Mode::Every && n % rule_.every != 0) return false;
   if (rule_.mode == Repreparation::Mode::Auto && (n - last_prepared_) % rule_.min_gap != 0)

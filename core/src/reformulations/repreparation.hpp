@@ -3,6 +3,7 @@
 
 #include "prepared_data.hpp"
 #include "tau_grid.hpp"
+#include "tsi/observer.hpp"
 
 namespace tsi {
 
@@ -19,14 +20,15 @@ struct Repreparation {
 
 /// Applies a Repreparation rule between the steps of a two-scale run: v_n = U(t_n, s_n),
 /// s_n = t_n/eps mod 2 pi, and U rebuilt as prepared data centred at s_n (U(t_n, s_n) = v_n
-/// exactly, so u(t_n) is unchanged), when the rule says so. It keeps the times it did.
-class Repreparer {
+/// exactly, so u(t_n) is unchanged), when the rule says so. It keeps the times it did. The
+/// driver calls it as an observer of the state (TwoScale::repreparation).
+class Repreparer final : public StateObserver {
  public:
   Repreparer(const TauGrid& grid, PreparedData& data, double eps, Repreparation rule)
       : grid_(grid), data_(data), eps_(eps), rule_(rule) {}
 
-  /// Between step n - 1 and step n (at time t): re-prepares y when due; true when it did.
-  bool between_steps(long n, double t, Vector& y);
+  /// After step n (at time t): re-prepares y when due; true when it did.
+  bool after_step(long n, double t, Vector& y) override;
   /// A new run: no re-preparation yet (the initial data are the last prepared, at step 0).
   void reset() {
     times_.clear();

@@ -68,8 +68,6 @@ Vector TwoScale::prepare(const Vector& u0) {
   return data_.at(u0, 0.0);
 }
 
-bool TwoScale::between_steps(long n, double t, Vector& y) { return repreparer_.between_steps(n, t, y); }
-
 Vector TwoScale::read_back(const Vector& y, double t) {
   const double tau = fast_phase(t, eps_);
   return model_->linear_flow(tau, grid_.evaluate(Eigen::Map<const Matrix>(y.data(), grid_.dim(), grid_.columns()), tau));

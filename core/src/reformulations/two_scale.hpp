@@ -69,7 +69,7 @@ class TwoScale final : public Reformulation, public TwoScaleDiagnostics {
   double tau_spread(const Vector& y) const override;
   /// Re-prepares U when the rule says so: v_n = U(t_n, s_n), s_n = t_n/eps mod 2 pi, and U
   /// rebuilt as prepared data centred at s_n (U(t_n, s_n) = v_n exactly, u(t_n) unchanged).
-  bool between_steps(long n, double t, Vector& y) override;
+  StateObserver* repreparation() override { return &repreparer_; }
   std::vector<double> repreparation_times() const override { return repreparer_.times(); }
   int data_order_reached() const override { return data_.order_reached(); }
   int threads() const override { return grid_.threads(); }
