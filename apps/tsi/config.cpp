@@ -264,7 +264,7 @@ Json resolve_run_config(const Json& raw, const Registry& registry) {
       throw ConfigError(key, "unknown section; valid sections are: " + join(sections));
 
   const Json empty = Json::object();
-  Json out = resolve_selection(raw, registry);  // model, reformulation, scheme: the core's assembler
+  Json out = resolve_selection(raw, registry).sections();  // model, reformulation, scheme: the core's assembler
 
   out["time"] = resolve_params(time_schema(), section_object(raw, "time", empty), "time");
   const long steps = step_count(out);  // t_end must be a whole number of steps
@@ -290,6 +290,14 @@ Json resolve_run_config(const Json& raw, const Registry& registry) {
     }
   }
   return out;
+}
+
+ResolvedSelection resolved_selection(const Json& resolved) {
+  const auto entry = [&](const char* key) {
+    const Json& section = resolved.at(key);
+    return ResolvedEntry{section.at("name").get<std::string>(), without_name(section)};
+  };
+  return {entry("model"), entry("reformulation"), entry("scheme")};
 }
 
 long step_count(const Json& resolved) {

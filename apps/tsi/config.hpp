@@ -5,6 +5,7 @@
 
 #include "tsi/params.hpp"
 #include "tsi/registry.hpp"
+#include "tsi/resolved_selection.hpp"
 
 namespace tsi::app {
 
@@ -37,6 +38,10 @@ void resolve_config_files(Json& raw, const std::string& config_path);
 /// Validates a run config against the registry and fills every default: the result names
 /// every parameter that the run uses (canonical names, model's n_tau, scheme's data order).
 Json resolve_run_config(const Json& raw, const Registry& registry);
+
+/// The model, reformulation and scheme of a resolved run config, as the core's assembler takes
+/// them (tsi::assemble).
+ResolvedSelection resolved_selection(const Json& resolved);
 
 /// Number of steps t_end / h (t_end must be a whole number of steps).
 long step_count(const Json& resolved);

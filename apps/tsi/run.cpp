@@ -197,7 +197,7 @@ ReferenceSolution compute_reference(const Json& config, const Registry& registry
   const auto start = Clock::now();
   if (out.settings["scheme"] == exact_reference) {
     const std::shared_ptr<const Model> model = model_with_exact_solution(config, registry, settings);
-    const Vector x0 = model->to_physical(initial_value(*model, config["model"]));
+    const Vector x0 = model->to_physical(initial_value(*model, without_name(config["model"])));
     const ExactSolution::Value exact = model->exact_solution()->at(x0, config["time"]["t_end"].get<double>());
     out.x = exact.x;
     out.accuracy = exact.accuracy;
@@ -286,10 +286,9 @@ Json dense_output_entry(const DenseOutput& dense, const RunOutcome& outcome) {
 // that stops being finite, or an interrupt, is an error.
 Vector final_state_with_steps(const Json& config, const Registry& registry, const RunSettings& settings, long steps,
                               const ProgressFn& progress, const char* what) {
-  AssemblyOptions options;
-  options.bind = false;
+  AssemblyOptions options;  // bound at the steps' size by final_model_state
   options.context = settings.context;
-  Assembly a = assemble(config, registry, options);
+  Assembly a = assemble(resolved_selection(config), registry, options);
   return a.model->to_physical(final_model_state(a, config["time"]["t_end"], steps, progress, what));
 }
 
@@ -355,10 +354,9 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   // Construction: bad input (a model's own checks, u0 of the wrong shape, a run that cannot fit
   // in memory) is a ConfigError that propagates before anything runs. The scheme is bound after
   // the data are prepared: the preparation's temporaries are gone by then.
-  AssemblyOptions assembly_options;
-  assembly_options.bind = false;
+  AssemblyOptions assembly_options;  // bound after the preparation (assembly.bind below)
   assembly_options.context = settings.context;
-  Assembly assembly = assemble(config, registry, assembly_options);
+  Assembly assembly = assemble(resolved_selection(config), registry, assembly_options);
   // A reference that could not finish is refused now, not after the run.
   check_run_steps(config, settings.max_steps);
   if (config.contains("reference") && !shared_reference) check_reference_cost(config, registry, settings);

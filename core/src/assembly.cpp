@@ -42,12 +42,6 @@ Json without_name(const Json& section) {
   return out;
 }
 
-Json with_name(const std::string& name, const Json& params) {
-  Json out = {{"name", name}};
-  out.update(params);
-  return out;
-}
-
 bool supports(const SchemeEntry& scheme, const std::string& reformulation) {
   const auto& r = scheme.traits.reformulations;
   return std::find(r.begin(), r.end(), reformulation) != r.end();
@@ -69,17 +63,16 @@ double available_bytes() {
 
 }  // namespace
 
-Footprint two_scale_footprint(const Model& model, const Json& reformulation, const Scheme& scheme,
+Footprint two_scale_footprint(const Model& model, const Params& reformulation, const Scheme& scheme,
                               const std::string& scheme_name, bool bound_before_preparation,
                               const Context& context) {
   Footprint f;
-  if (!reformulation.contains("n_tau") || !reformulation["n_tau"].is_number()) return f;
+  if (!reformulation.has("n_tau")) return f;  // not the two-scale reformulation
   f.dim = static_cast<double>(model.dim());
-  f.n_tau = reformulation["n_tau"].get<double>();
+  f.n_tau = static_cast<double>(reformulation.integer("n_tau"));
   // A real model's state holds tau modes 0 .. n_tau/2 (the real layout).
-  const auto real_layout = reformulation.find("real_layout");
   const bool real = TwoScale::real_layout_for(model) &&
-                    !(real_layout != reformulation.end() && real_layout->is_boolean() && !real_layout->get<bool>());
+                    !(reformulation.has("real_layout") && !reformulation.boolean("real_layout"));
   const double modes = real ? f.n_tau / 2 + 1 : f.n_tau;
   f.state_bytes = 16.0 * f.dim * modes;
   f.scheme = scheme_name;
@@ -90,8 +83,10 @@ Footprint two_scale_footprint(const Model& model, const Json& reformulation, con
   layout.size = static_cast<Index>(std::min(size, 9e18));
   layout.diagonal_values = per_tau_mode ? static_cast<Index>(modes) : layout.size;
   f.scheme_vectors = scheme.state_vectors(layout);
-  const int order = reformulation.value("initial_data_order", 1);
-  const std::string method = reformulation.value("initial_data_method", std::string("auto"));
+  const int order =
+      reformulation.has("initial_data_order") ? static_cast<int>(reformulation.integer("initial_data_order")) : 1;
+  const std::string method =
+      reformulation.has("initial_data_method") ? reformulation.string("initial_data_method") : std::string("auto");
   double preparation = 0.0;
   const double work = TwoScale::work_vectors(model, order, method, &preparation);
   f.problem_vectors = work - preparation;
@@ -165,7 +160,17 @@ std::string checked_u0_file(const Json& value) {
 
 }  // namespace
 
-Json resolve_selection(const Json& config, const Registry& registry) {
+Json ResolvedEntry::section() const {
+  Json out = {{"name", name}};
+  out.update(params);
+  return out;
+}
+
+Json ResolvedSelection::sections() const {
+  return {{"model", model.section()}, {"reformulation", reformulation.section()}, {"scheme", scheme.section()}};
+}
+
+ResolvedSelection resolve_selection(const Json& config, const Registry& registry) {
   if (!config.is_object()) throw ConfigError("config", "got " + config.dump() + ", expected a JSON object");
   const Json& model = section_object(config, "model");
   const Json& scheme = section_object(config, "scheme");
@@ -195,9 +200,9 @@ Json resolve_selection(const Json& config, const Registry& registry) {
   if (scheme_entry.complete) scheme_entry.complete(scheme_params, selection);
   selection.scheme_params = &scheme_params;
   if (reformulation_entry.complete) reformulation_entry.complete(reformulation_params, selection);
-  return {{"model", with_name(model_entry.info.name, model_params)},
-          {"reformulation", with_name(reformulation_entry.info.name, reformulation_params)},
-          {"scheme", with_name(scheme_entry.info.name, scheme_params)}};
+  return {{model_entry.info.name, std::move(model_params)},
+          {reformulation_entry.info.name, std::move(reformulation_params)},
+          {scheme_entry.info.name, std::move(scheme_params)}};
 }
 
 namespace {
@@ -255,9 +260,9 @@ Vector initial_value_from_file(const Model& model, const std::string& file) {
 
 }  // namespace
 
-Vector initial_value(const Model& model, const Json& model_section) {
-  if (!model_section.contains("u0") || model_section["u0"].is_null()) return model.initial_value();
-  const Json& u0 = model_section["u0"];
+Vector initial_value(const Model& model, const Json& model_params) {
+  if (!model_params.contains("u0") || model_params["u0"].is_null()) return model.initial_value();
+  const Json& u0 = model_params["u0"];
   if (u0.is_string()) return initial_value_from_file(model, u0.get<std::string>());
   if (!u0.is_array() || static_cast<Index>(u0.size()) != model.physical_dim())
     throw ConfigError("model.u0", fmt::format("got {} entries, expected {} (the model's dimension)",
@@ -278,23 +283,23 @@ Vector initial_value(const Model& model, const Json& model_section) {
   return model.from_physical(x);
 }
 
-Assembly assemble(const Json& resolved, const Registry& registry, const AssemblyOptions& options) {
+Assembly assemble(const ResolvedSelection& resolved, const Registry& registry, const AssemblyOptions& options) {
   Assembly a;
-  a.model_entry = &registry.model(resolved.at("model").at("name"));
-  a.reformulation_entry = &registry.reformulation(resolved.at("reformulation").at("name"));
-  a.scheme_entry = &registry.scheme(resolved.at("scheme").at("name"));
-  a.model = a.model_entry->create(Params(without_name(resolved["model"]), options.context));
-  a.u0 = initial_value(*a.model, resolved["model"]);
-  a.traits = scheme_traits(*a.scheme_entry, without_name(resolved["scheme"]));
+  a.model_entry = &registry.model(resolved.model.name);
+  a.reformulation_entry = &registry.reformulation(resolved.reformulation.name);
+  a.scheme_entry = &registry.scheme(resolved.scheme.name);
+  a.model = a.model_entry->create(Params(resolved.model.params, options.context));
+  a.u0 = initial_value(*a.model, resolved.model.params);
+  a.traits = scheme_traits(*a.scheme_entry, resolved.scheme.params);
   // The scheme first (its parameters only): its vector count for the problem's layout sizes the
   // footprint, checked before the reformulation allocates anything of the state's size.
-  a.scheme = a.scheme_entry->create(Params(without_name(resolved["scheme"]), options.context));
-  const bool binds = options.bind && resolved.contains("time") && resolved["time"].contains("h") &&
-                     resolved["time"]["h"].is_number();
-  a.footprint = two_scale_footprint(*a.model, resolved["reformulation"], *a.scheme, a.scheme_entry->info.name, binds,
+  a.scheme = a.scheme_entry->create(Params(resolved.scheme.params, options.context));
+  const Params reformulation_params(resolved.reformulation.params, options.context);
+  const bool binds = options.h > 0.0;
+  a.footprint = two_scale_footprint(*a.model, reformulation_params, *a.scheme, a.scheme_entry->info.name, binds,
                                     options.context);
   check_footprint(a.footprint, options.memory_bytes);
-  a.reformulation = a.reformulation_entry->create(a.model, Params(without_name(resolved["reformulation"]), options.context));
+  a.reformulation = a.reformulation_entry->create(a.model, reformulation_params);
   const StepperTraits& traits = a.traits;
   const std::string pair = fmt::format("model \"{}\" on the \"{}\" reformulation", a.model_entry->info.name,
                                        a.reformulation_entry->info.name);
@@ -311,7 +316,7 @@ Assembly assemble(const Json& resolved, const Registry& registry, const Assembly
                                   a.model->has_exact_nonlinear_flow()
                                       ? " (only \"direct\" in model variables does)"
                                       : " (the model has no exact nonlinear flow)"));
-  if (binds) a.bind(resolved["time"]["h"].get<double>());
+  if (binds) a.bind(options.h);
   return a;
 }
 

@@ -330,8 +330,8 @@ std::vector<double> ModelChecks::errors(const SchemeEntry& scheme, double eps, c
                      {"scheme", {{"name", scheme.info.name}}}};
       for (const auto& p : scheme.info.params)
         if (options_.scheme_params.contains(p.name)) config["scheme"][p.name] = options_.scheme_params[p.name];
-      const Json resolved = resolve_selection(config, registry_);
-      config["reformulation"]["n_tau"] = n_tau_factor * resolved["reformulation"]["n_tau"].get<long>();
+      const ResolvedSelection resolved = resolve_selection(config, registry_);
+      config["reformulation"]["n_tau"] = n_tau_factor * resolved.reformulation.params["n_tau"].get<long>();
       if (data_order > 0) config["reformulation"]["initial_data_order"] = data_order;
       for (const auto& p : scheme.info.params)
         if (p.name == "tol") config["scheme"]["tol"] = 1e-14;

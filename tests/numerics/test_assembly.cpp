@@ -35,20 +35,23 @@ Vector se2_solution(const Json& nodes, long steps) {
 TEST_CASE("assembly: each entry completes its defaults from the selection") {
   const auto& registry = Harness::instance().registry();
   // SE2's nodes follow the model's nonlinearity: polynomial of degree 3 -> 2, non-polynomial -> 6.
-  CHECK(tsi::resolve_selection(selection("henon-heiles", "se2"), registry)["scheme"]["quadrature_nodes"] == 2);
-  CHECK(tsi::resolve_selection(selection("nls", "se2"), registry)["scheme"]["quadrature_nodes"] == 2);
-  CHECK(tsi::resolve_selection(selection("cpd", "se2"), registry)["scheme"]["quadrature_nodes"] == 6);
+  CHECK(tsi::resolve_selection(selection("henon-heiles", "se2"), registry).scheme.params["quadrature_nodes"] == 2);
+  CHECK(tsi::resolve_selection(selection("nls", "se2"), registry).scheme.params["quadrature_nodes"] == 2);
+  CHECK(tsi::resolve_selection(selection("cpd", "se2"), registry).scheme.params["quadrature_nodes"] == 6);
   Json given = selection("cpd", "se2");
   given["scheme"]["quadrature_nodes"] = 3;
-  CHECK(tsi::resolve_selection(given, registry)["scheme"]["quadrature_nodes"] == 3);
+  CHECK(tsi::resolve_selection(given, registry).scheme.params["quadrature_nodes"] == 3);
   // The two-scale reformulation: n_tau from the model, data order from the scheme.
-  const Json fd = tsi::resolve_selection(selection("nls", "fd"), registry);
-  CHECK(fd["reformulation"]["name"] == "two-scale");
-  CHECK(fd["reformulation"]["n_tau"] == registry.model("nls").default_n_tau);
-  CHECK(fd["reformulation"]["initial_data_order"] == 3);
-  CHECK(tsi::resolve_selection(selection("nls", "se1"), registry)["reformulation"]["initial_data_order"] == 2);
+  const tsi::ResolvedSelection fd = tsi::resolve_selection(selection("nls", "fd"), registry);
+  CHECK(fd.reformulation.name == "two-scale");
+  CHECK(fd.reformulation.params["n_tau"] == registry.model("nls").default_n_tau);
+  CHECK(fd.reformulation.params["initial_data_order"] == 3);
+  // The sections as a config writes them (result.json's config).
+  CHECK(fd.sections()["reformulation"]["name"] == "two-scale");
+  CHECK(fd.sections()["scheme"]["name"] == "fd");
+  CHECK(tsi::resolve_selection(selection("nls", "se1"), registry).reformulation.params["initial_data_order"] == 2);
   // Aliases resolve to canonical names.
-  CHECK(tsi::resolve_selection(selection("henon-heiles", "se1-tsi"), registry)["scheme"]["name"] == "se1");
+  CHECK(tsi::resolve_selection(selection("henon-heiles", "se1-tsi"), registry).scheme.name == "se1");
 }
 
 TEST_CASE("assembly: the charged particle's SE2 runs with the nodes its force needs") {

@@ -88,7 +88,6 @@ TEST_CASE("memory: the footprint check counts the bound scheme's vectors and ref
   auto& h = Harness::instance();
   const auto footprint = [&](const std::string& scheme) {
     tsi::AssemblyOptions options;
-    options.bind = false;
     return tsi::assemble_config(nls_config(scheme), h.registry(), options).footprint;
   };
   const tsi::Footprint se1 = footprint("se1"), eab = footprint("eab");
@@ -106,7 +105,6 @@ TEST_CASE("memory: the footprint check counts the bound scheme's vectors and ref
   // A limit just above the footprint admits the run, one just below refuses it before the
   // reformulation is built, naming the sizes and the scheme's share.
   tsi::AssemblyOptions options;
-  options.bind = false;
   options.memory_bytes = 1.01 * eab.bytes();
   CHECK(tsi::assemble_config(nls_config("eab"), h.registry(), options).reformulation != nullptr);
   options.memory_bytes = 0.99 * eab.bytes();
@@ -133,7 +131,6 @@ TEST_CASE("memory: the footprint counts the whole grid that unbuffered tau trans
   auto& h = Harness::instance();
   const auto footprint = [&](long n_tau, int fft_threads) {
     tsi::AssemblyOptions options;
-    options.bind = false;
     options.context = tsi::Context::with_threads(1, fft_threads);
     options.context.fft.min_values = 0;
     return tsi::assemble_config(nls_config("se1", 128, n_tau), h.registry(), options).footprint;

@@ -5,6 +5,7 @@
 #include "tsi/export.hpp"
 #include "tsi/params.hpp"
 #include "tsi/registry.hpp"
+#include "tsi/resolved_selection.hpp"
 
 namespace tsi {
 
@@ -14,8 +15,8 @@ namespace tsi {
 /// entry from the selection (the reformulation's n_tau and data order, SE2's quadrature nodes),
 /// and the scheme/reformulation pair checked. The reformulation defaults to "two-scale" when
 /// the scheme integrates it, else to the scheme's first. Bad input is a ConfigError naming the
-/// field. Returns {"model": {...}, "reformulation": {...}, "scheme": {...}}, each with "name".
-TSI_API Json resolve_selection(const Json& config, const Registry& registry);
+/// field. Other sections of the config are not read.
+TSI_API ResolvedSelection resolve_selection(const Json& config, const Registry& registry);
 
 /// The memory a two-scale run of a selection holds at its peak, in vectors of the state's size
 /// (dim x n_tau complex values), known before anything of that size is allocated: the state, the
@@ -35,9 +36,10 @@ struct TSI_API Footprint {
 
 /// How assemble builds a run.
 struct TSI_API AssemblyOptions {
-  /// Bind the scheme to time.h when the config has it. A run binds after it has prepared its
-  /// data (false here, then Assembly::bind): the preparation's temporaries are freed by then.
-  bool bind = true;
+  /// Bind the scheme to this step size (0: not bound; Assembly::bind later). A run binds after
+  /// it has prepared its data (0 here, then Assembly::bind): the preparation's temporaries are
+  /// freed by then.
+  double h = 0.0;
   /// The memory a two-scale run may take, in bytes (0: what the machine has available now);
   /// a run whose footprint exceeds it is refused, naming its sizes, before it is built.
   double memory_bytes = 0.0;
@@ -48,7 +50,7 @@ struct TSI_API AssemblyOptions {
 /// The footprint of a two-scale run of `model` with these resolved reformulation parameters
 /// and this scheme (bound before or after the preparation of the data), in this context (FFTW's
 /// threads decide whether the tau transforms hold a whole grid of their own).
-TSI_API Footprint two_scale_footprint(const Model& model, const Json& reformulation, const Scheme& scheme,
+TSI_API Footprint two_scale_footprint(const Model& model, const Params& reformulation, const Scheme& scheme,
                                       const std::string& scheme_name, bool bound_before_preparation,
                                       const Context& context = {});
 
@@ -61,7 +63,7 @@ struct TSI_API Assembly {
   std::shared_ptr<const Model> model;
   std::unique_ptr<Reformulation> reformulation;
   std::unique_ptr<Scheme> scheme;
-  /// The scheme bound to the reformulation: by assemble when the config has time.h, else by bind.
+  /// The scheme bound to the reformulation: by assemble with AssemblyOptions::h, else by bind.
   std::unique_ptr<Stepper> stepper;
   Vector u0;  ///< the initial value in model variables (model.u0 in physical variables, or the model's own)
   Footprint footprint;  ///< what the run will hold at its peak (checked before the reformulation was built)
@@ -76,7 +78,8 @@ struct TSI_API Assembly {
 /// model and reformulation; a two-scale run whose footprint exceeds the memory available
 /// (options.memory_bytes) is a ConfigError on reformulation.n_tau naming its sizes, raised before
 /// the reformulation is built.
-TSI_API Assembly assemble(const Json& resolved, const Registry& registry, const AssemblyOptions& options = {});
+TSI_API Assembly assemble(const ResolvedSelection& resolved, const Registry& registry,
+                          const AssemblyOptions& options = {});
 
 /// resolve_selection then assemble.
 TSI_API Assembly assemble_config(const Json& config, const Registry& registry, const AssemblyOptions& options = {});
@@ -86,6 +89,7 @@ TSI_API Assembly assemble_config(const Json& config, const Registry& registry, c
 /// float64 or complex128 values, as many as the model's dimension in any shape, finite, and
 /// real for a real model) or the model's default. resolve_selection makes a file name absolute
 /// (relative to the working directory) and checks its header; the values are read here.
-TSI_API Vector initial_value(const Model& model, const Json& model_section);
+/// `model_params`: the resolved model's parameters (ResolvedEntry::params).
+TSI_API Vector initial_value(const Model& model, const Json& model_params);
 
 }  // namespace tsi
