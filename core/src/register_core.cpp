@@ -13,6 +13,17 @@ int default_quadrature_nodes(const ModelEntry& model) {
   return model.nonlinearity_degree > 0 ? (model.nonlinearity_degree + 2) / 2 : 6;
 }
 
+namespace {
+
+// The filtered and direct problems' real_layout.
+ParamSpec real_state_param() {
+  return bool_param("real_layout", true,
+                    "a real model's state holds its real values two to a complex entry (half the memory; "
+                    "the same numbers); false: one value per entry, as for a complex model");
+}
+
+}  // namespace
+
 void register_core(Registry& registry) {
   const auto previous = registry.provider();
   registry.set_provider("core");
@@ -102,9 +113,9 @@ void register_core(Registry& registry) {
   ReformulationEntry filtered;
   filtered.info = {"filtered", {"filter"},
                    "v = e^{-JM t/eps} u, v' = f_{t/eps}(v): no stiff part, period 2 pi eps in t",
-                   {}, ""};
-  filtered.create = [](std::shared_ptr<const Model> model, const Params&) {
-    return std::make_unique<Filtered>(std::move(model));
+                   {real_state_param()}, ""};
+  filtered.create = [](std::shared_ptr<const Model> model, const Params& p) {
+    return std::make_unique<Filtered>(std::move(model), !p.has("real_layout") || p.boolean("real_layout"));
   };
   registry.add_reformulation(std::move(filtered));
 
@@ -112,11 +123,13 @@ void register_core(Registry& registry) {
   direct.info = {"direct", {}, "u' = J[(1/eps) M u + grad H1(u)] as it stands (classical solvers)",
                  {string_param("variables", "model",
                                "the variables integrated: u (model), or those errors are measured in (physical)")
-                      .choices({"model", "physical"})},
+                      .choices({"model", "physical"}),
+                  real_state_param()},
                  ""};
   direct.create = [](std::shared_ptr<const Model> model, const Params& p) {
     const bool physical = p.has("variables") && p.string("variables") == "physical";
-    return std::make_unique<Direct>(std::move(model), physical ? Direct::Variables::physical : Direct::Variables::model);
+    return std::make_unique<Direct>(std::move(model), physical ? Direct::Variables::physical : Direct::Variables::model,
+                                    !p.has("real_layout") || p.boolean("real_layout"));
   };
   registry.add_reformulation(std::move(direct));
 

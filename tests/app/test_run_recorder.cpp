@@ -68,7 +68,7 @@ TEST_CASE("recorder: a declared invariant gets a value and a change column, rela
   tsi::app::RunRecorder recorder(*s.model, *s.direct, exact(0.0), config(0.5, 1.0));
   for (long n = 0; n <= 2; ++n) {
     const double t = 0.5 * static_cast<double>(n);
-    REQUIRE(recorder.observe(n, t, exact(t)));
+    REQUIRE(recorder.observe(n, t, s.direct->prepare(exact(t))));
   }
   const std::string csv = recorder.csv();
   CHECK(csv.substr(0, csv.find('\n')) == "t,H,I,m,err_H,err_I,err_m,tau_roughness,tau_spread,Q,err_Q,z,abs_err_z");
@@ -139,7 +139,7 @@ TEST_CASE("recorder: invariants and monitors run every output.every steps, a fin
   tsi::app::RunRecorder recorder(*s.model, *s.direct, exact(0.0), cfg);
   const long at_start = *calls;
   const auto time = [](long n) { return 0.1 * static_cast<double>(n); };
-  for (long n = 0; n <= 20; ++n) REQUIRE(recorder.observe(n, time(n), exact(time(n))));
+  for (long n = 0; n <= 20; ++n) REQUIRE(recorder.observe(n, time(n), s.direct->prepare(exact(time(n)))));
   CHECK(*calls - at_start == 4);  // steps 0, 7, 14 and the last, 20
   CHECK(recorder.steps() == 20);
   // The rows are those steps; the maximum of err_H is over them.
@@ -148,9 +148,9 @@ TEST_CASE("recorder: invariants and monitors run every output.every steps, a fin
 
   // A non-finite state between two recorded steps stops the run there, naming both steps.
   tsi::app::RunRecorder watched(*s.model, *s.direct, exact(0.0), cfg);
-  for (long n = 0; n <= 8; ++n) REQUIRE(watched.observe(n, time(n), exact(time(n))));
-  Vector bad = exact(time(9));
-  bad(1) = std::numeric_limits<double>::quiet_NaN();
+  for (long n = 0; n <= 8; ++n) REQUIRE(watched.observe(n, time(n), s.direct->prepare(exact(time(n)))));
+  Vector bad = s.direct->prepare(exact(time(9)));  // the problem's state (a real model's: packed)
+  bad(0) = std::numeric_limits<double>::quiet_NaN();
   CHECK_FALSE(watched.observe(9, time(9), bad));
   CHECK(watched.status() == "blow-up");
   CHECK(watched.message().find("non-finite at t = 0.9 (step 9)") != std::string::npos);

@@ -32,7 +32,7 @@ void require_linear_to_physical(const Model& model) {
 
 }  // namespace
 
-Direct::Direct(std::shared_ptr<const Model> model, Variables variables)
+Direct::Direct(std::shared_ptr<const Model> model, Variables variables, bool real_layout)
     : Reformulation(std::move(model)),
       physical_(variables == Variables::physical),
       size_(model_->dim()),
@@ -41,7 +41,8 @@ Direct::Direct(std::shared_ptr<const Model> model, Variables variables)
       field_(model_->dim(), 1),
       mu_(model_->dim()),
       au_(model_->dim()),
-      remainder_(model_remainder(*model_)) {
+      remainder_(model_remainder(*model_)),
+      packing_(model_->dim(), real_layout && !model_->is_complex() && remainder_.size() == 0) {
   if (physical_) {
     if (model_->physical_dim() != model_->dim())
       throw ConfigError("reformulation.variables",
@@ -51,6 +52,44 @@ Direct::Direct(std::shared_ptr<const Model> model, Variables variables)
     require_linear_to_physical(*model_);
     size_ = model_->physical_dim();
   }
+  if (packing_.on()) {
+    x_.setZero(size_);
+    result_.setZero(size_);
+  }
+}
+
+const Vector& Direct::values_of(const Vector& y) {
+  if (!packing_.on()) return y;
+  packing_.unpack(y.data(), x_.data());
+  return x_;
+}
+
+void Direct::store(const Vector& values, Vector& out) const {
+  if (!packing_.on()) {
+    if (&out != &values) out = values;
+    return;
+  }
+  out.resize(packing_.size());
+  packing_.pack(values.data(), out.data());
+}
+
+void Direct::linear_flow(double h, Vector& y) {
+  if (!packing_.on()) {
+    y = model_->linear_flow(fast_phase(h, model_->eps()), y);
+    model_->remainder_flow(h, y);
+    return;
+  }
+  Vector x = model_->linear_flow(fast_phase(h, model_->eps()), values_of(y));
+  model_->remainder_flow(h, x);
+  store(x, y);
+}
+
+void Direct::nonlinear_flow(double /*t*/, double h, Vector& y) {
+  ++evaluations_;
+  if (!packing_.on()) return model_->nonlinear_flow(h, y);
+  packing_.unpack(y.data(), x_.data());
+  model_->nonlinear_flow(h, x_);
+  store(x_, y);
 }
 
 void Direct::model_nonlinear(const Vector& u, Vector& out) {
@@ -73,23 +112,36 @@ void Direct::model_rhs(const Vector& u, Vector& out) {
 
 void Direct::nonlinear(double /*t*/, const Vector& y, Vector& out) {
   ++evaluations_;
-  if (!physical_) return model_nonlinear(y, out);
-  model_nonlinear(model_->from_physical(y), out);
-  out = model_->to_physical(out);
+  const Vector& x = values_of(y);
+  Vector& result = packing_.on() ? result_ : out;
+  if (!physical_) {
+    model_nonlinear(x, result);
+  } else {
+    model_nonlinear(model_->from_physical(x), result);
+    result = model_->to_physical(result);
+  }
+  store(result, out);
 }
 
 void Direct::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& dy, Vector& out) {
-  state_.col(0) = physical_ ? model_->from_physical(y) : y;
-  direction_.col(0) = physical_ ? model_->from_physical(dy) : dy;
+  const Vector x = packing_.unpacked(y), dx = packing_.unpacked(dy);
+  state_.col(0) = physical_ ? model_->from_physical(x) : x;
+  direction_.col(0) = physical_ ? model_->from_physical(dx) : dx;
   model_->nonlinear_field_derivative(state_, direction_, field_);
-  out = physical_ ? model_->to_physical(field_.col(0)) : Vector(field_.col(0));
+  store(physical_ ? model_->to_physical(field_.col(0)) : Vector(field_.col(0)), out);
 }
 
 void Direct::rhs(double /*t*/, const Vector& y, Vector& out) {
   ++evaluations_;
-  if (!physical_) return model_rhs(y, out);
-  model_rhs(model_->from_physical(y), out);
-  out = model_->to_physical(out);
+  const Vector& x = values_of(y);
+  Vector& result = packing_.on() ? result_ : out;
+  if (!physical_) {
+    model_rhs(x, result);
+  } else {
+    model_rhs(model_->from_physical(x), result);
+    result = model_->to_physical(result);
+  }
+  store(result, out);
 }
 
 }  // namespace tsi

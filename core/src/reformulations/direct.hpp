@@ -1,4 +1,5 @@
 #pragma once
+#include "real_packing.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/reformulation.hpp"
 
@@ -13,12 +14,18 @@ namespace tsi {
 /// measured in. This matters when T is ill-conditioned in eps (the charged particle's
 /// v = (p + B q) / (2 eps)): a tolerance on u is then a tolerance 1/eps larger on x.
 /// T must be linear; the constructor checks it.
+///
+/// A real model's state is real: with `real_layout` it holds the d values two to an entry
+/// (tsi::RealPacking; half the memory, the same numbers).
 class Direct final : public Reformulation {
  public:
   enum class Variables { model, physical };
-  explicit Direct(std::shared_ptr<const Model> model, Variables variables = Variables::model);
+  explicit Direct(std::shared_ptr<const Model> model, Variables variables = Variables::model,
+                  bool real_layout = true);
 
-  Index size() const override { return size_; }
+  Index size() const override { return packing_.size(); }
+  /// True when the state holds a real model's values two to an entry.
+  bool real_layout() const { return packing_.on(); }
   const Diagonal& linear_multipliers() const override { return none_; }
   void nonlinear(double t, const Vector& y, Vector& out) override;
   void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
@@ -26,20 +33,21 @@ class Direct final : public Reformulation {
 
   /// Exact flows when the model has an exact nonlinear flow: e^{hL} = e^{JM h/eps}.
   bool has_exact_flows() const override { return !physical_ && model_->has_exact_nonlinear_flow(); }
-  void linear_flow(double h, Vector& y) override {
-    y = model_->linear_flow(fast_phase(h, model_->eps()), y);
-    model_->remainder_flow(h, y);
-  }
+  void linear_flow(double h, Vector& y) override;
   /// One exact nonlinear flow counts as one evaluation of N (the work measure of splitting).
-  void nonlinear_flow(double /*t*/, double h, Vector& y) override {
-    ++evaluations_;
-    model_->nonlinear_flow(h, y);
-  }
+  void nonlinear_flow(double t, double h, Vector& y) override;
 
-  Vector prepare(const Vector& u0) override { return physical_ ? model_->to_physical(u0) : u0; }
-  Vector read_back(const Vector& y, double /*t*/) override { return physical_ ? model_->from_physical(y) : y; }
+  Vector prepare(const Vector& u0) override { return packing_.packed(physical_ ? model_->to_physical(u0) : u0); }
+  Vector read_back(const Vector& y, double /*t*/) override {
+    const Vector x = packing_.unpacked(y);
+    return physical_ ? model_->from_physical(x) : x;
+  }
 
  private:
+  // The state as d values: y itself, or y unpacked into x_.
+  const Vector& values_of(const Vector& y);
+  // `values` (d) into out (packed when the packing is on; out may then not be `values`).
+  void store(const Vector& values, Vector& out) const;
   void model_nonlinear(const Vector& u, Vector& out);
   void model_rhs(const Vector& u, Vector& out);
 
@@ -49,6 +57,8 @@ class Direct final : public Reformulation {
   Matrix state_, direction_, field_;
   Vector mu_, au_;  // M u and A u
   Vector remainder_;  // i omega per coordinate (empty without a remainder)
+  RealPacking packing_;
+  Vector x_, result_;  // the state and N as d values, where the packing is on
 };
 
 }  // namespace tsi
