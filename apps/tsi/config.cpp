@@ -242,13 +242,15 @@ void assign_path(Json& config, const std::string& path, const Json& value, const
 void resolve_config_files(Json& raw, const std::string& config_path) {
   if (!raw.is_object() || !raw.contains("model") || !raw["model"].is_object()) return;
   Json& model = raw["model"];
-  if (!model.contains("u0") || !model["u0"].is_string() || model["u0"].get<std::string>().empty()) return;
-  const std::filesystem::path file = model["u0"].get<std::string>();
-  if (file.is_absolute()) return;
-  std::error_code ec;
-  const std::filesystem::path resolved =
-      std::filesystem::absolute(std::filesystem::path(config_path).parent_path() / file, ec);
-  if (!ec) model["u0"] = resolved.lexically_normal().string();
+  for (const char* key : model_file_keys) {
+    if (!model.contains(key) || !model[key].is_string() || model[key].get<std::string>().empty()) continue;
+    const std::filesystem::path file = model[key].get<std::string>();
+    if (file.is_absolute()) continue;
+    std::error_code ec;
+    const std::filesystem::path resolved =
+        std::filesystem::absolute(std::filesystem::path(config_path).parent_path() / file, ec);
+    if (!ec) model[key] = resolved.lexically_normal().string();
+  }
 }
 
 Json without_name(const Json& section) {

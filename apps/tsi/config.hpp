@@ -29,10 +29,14 @@ void assign_path(Json& config, const std::string& path, const Json& value, const
 /// A path through a non-object, or an unknown section, is a ConfigError naming the path.
 void apply_override(Json& config, const std::string& assignment);
 
-/// Makes a file a run config names relative to the config file absolute: model.u0 as the
-/// name of a .npy file, relative to the directory of `config_path` (the run config, or the
-/// study whose base, cases or lists it comes from), as the config's plugins are. An absolute
-/// name, an array, or a config without u0 are left as they are.
+/// The model parameters that may name a file: u0 (a .npy state) and particles (a particle
+/// model's initial particles).
+inline constexpr const char* model_file_keys[] = {"u0", "particles"};
+
+/// Makes a file a run config names relative to the config file absolute: model.u0 and
+/// model.particles as file names, relative to the directory of `config_path` (the run config,
+/// or the study whose base, cases or lists it comes from), as the config's plugins are. An
+/// absolute name, a value that is not a string, or a config without them are left as they are.
 void resolve_config_files(Json& raw, const std::string& config_path);
 
 /// Validates a run config against the registry and fills every default: the result names

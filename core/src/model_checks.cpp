@@ -673,12 +673,16 @@ ModelCheckReport check_model(const Registry& registry, const ModelEntry& entry,
   ModelCheckOptions model_options = options;
   if (model_options.epsilons.empty()) model_options.epsilons = entry.verification.epsilons;
   if (model_options.steps.empty()) model_options.steps = entry.verification.steps;
+  for (const auto& [key, value] : entry.verification.params.items())
+    if (!model_options.model_params.contains(key)) model_options.model_params[key] = value;
   ModelChecks checks(registry, entry, model_options, out);
   try {
     check_regime(model_options.epsilons, model_options.steps);
     const auto m = checks.model(model_options.epsilons.front());
-    fmt::print(out, "  dim {}, {}, default n_tau {}, nonlinearity degree {}\n\n", m->dim(),
-               m->is_complex() ? "complex" : "real", entry.default_n_tau, entry.nonlinearity_degree);
+    fmt::print(out, "  dim {}, {}, default n_tau {}, nonlinearity degree {}{}\n\n", m->dim(),
+               m->is_complex() ? "complex" : "real", entry.default_n_tau, entry.nonlinearity_degree,
+               model_options.model_params.empty() ? std::string()
+                                                  : ", model parameters " + model_options.model_params.dump());
     checks.interface(model_options.epsilons.front());
     checks.convergence(schemes, model_options.epsilons);
   } catch (const std::exception& e) {

@@ -1,0 +1,104 @@
+#include "particles.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "tsi/error.hpp"
+#include "tsi/npy.hpp"
+#include "tsi/phase.hpp"
+
+namespace tsi::pic {
+namespace {
+
+// A double in [0, 1) from the generator's top 53 bits: the same on every platform
+// (std::uniform_real_distribution and std::generate_canonical are not specified that far).
+double uniform(std::mt19937_64& gen) { return static_cast<double>(gen() >> 11) * 0x1.0p-53; }
+
+}  // namespace
+
+RealVector sample_particles(const Geometry& g, Distribution distribution, double alpha, std::uint64_t seed) {
+  std::mt19937_64 gen(seed);
+  RealVector u(4 * g.particles);
+  const double lx = g.length_x(), ly = g.length_y();
+  for (Index k = 0; k < g.particles; ++k) {
+    double x1 = 0.0, x2 = 0.0;
+    if (distribution == Distribution::landau) {
+      for (;;) {  // x1 by rejection under 1 + alpha, x2 uniform
+        x1 = uniform(gen) * lx;
+        if (uniform(gen) * (1.0 + alpha) <= 1.0 + alpha * std::cos(g.k_x * x1)) break;
+      }
+      x2 = uniform(gen) * ly;
+    } else {
+      for (;;) {
+        x1 = uniform(gen) * lx;
+        x2 = uniform(gen) * ly;
+        if (uniform(gen) * (2.0 + alpha) <= 1.0 + std::sin(x2) + alpha * std::cos(g.k_x * x1)) break;
+      }
+    }
+    double v1 = 0.0, v2 = 0.0;
+    if (distribution == Distribution::landau) {  // Box-Muller
+      const double r = std::sqrt(-2.0 * std::log(1.0 - uniform(gen))), theta = two_pi * uniform(gen);
+      v1 = r * std::cos(theta);
+      v2 = r * std::sin(theta);
+    } else {
+      for (;;) {
+        v1 = (uniform(gen) - 0.5) * 10.0;
+        v2 = (uniform(gen) - 0.5) * 10.0;
+        const double f = 0.5 * (std::exp(-((v1 - 2.0) * (v1 - 2.0) + v2 * v2) / 2.0) +
+                                std::exp(-((v1 + 2.0) * (v1 + 2.0) + v2 * v2) / 2.0));
+        if (uniform(gen) <= f) break;
+      }
+    }
+    u.segment(4 * k, 4) << x1, x2, v1, v2;
+  }
+  return u;
+}
+
+RealVector read_particles(const std::string& file) {
+  const auto refuse = [&](const std::string& what) {
+    return ConfigError("model.particles", file + ": " + what);
+  };
+  RealVector u;
+  if (std::filesystem::path(file).extension() == ".npy") {
+    NpyArray array;
+    try {
+      array = read_npy(file);
+    } catch (const Error& e) {
+      throw ConfigError("model.particles", e.what());
+    }
+    const auto& shape = array.header.shape;
+    const bool n_by_4 = shape.size() == 2 && shape[1] == 4, flat = shape.size() == 1 && shape[0] % 4 == 0;
+    if (array.header.is_complex || !(n_by_4 || flat) || array.header.count == 0)
+      throw refuse("an array of shape " + npy_shape_text(shape) + " (" + array.header.descr +
+                   "), expected float64 of shape (N, 4): x1 x2 v1 v2 per particle");
+    u = array.values.real();
+  } else {
+    std::error_code ec;
+    const auto bytes = std::filesystem::file_size(file, ec);
+    if (ec) throw refuse("cannot read it (" + ec.message() + ")");
+    if (bytes == 0 || bytes % 32 != 0)
+      throw refuse(std::to_string(bytes) +
+                   " bytes, expected a positive multiple of 32 (the raw layout: 4 little-endian float64 per particle; "
+                   "a NumPy file must end in .npy)");
+    if (bytes / 32 > (std::uintmax_t{1} << 28))
+      throw refuse(std::to_string(bytes / 32) + " particles, expected at most 2^28");
+    u.resize(static_cast<Index>(bytes / 8));
+    std::ifstream in(file, std::ios::binary);
+    if (!in.read(reinterpret_cast<char*>(u.data()), static_cast<std::streamsize>(bytes)))
+      throw refuse("cannot read it");
+  }
+  if (u.size() / 4 > (Index{1} << 28)) throw refuse(std::to_string(u.size() / 4) + " particles, expected at most 2^28");
+  static constexpr const char* names[4] = {"x1", "x2", "v1", "v2"};
+  for (Index i = 0; i < u.size(); ++i)
+    if (!std::isfinite(u(i))) {
+      std::ostringstream what;
+      what << "particle " << i / 4 << " has " << names[i % 4] << " = " << u(i) << "; expected finite values";
+      throw refuse(what.str());
+    }
+  return u;
+}
+
+}  // namespace tsi::pic

@@ -1,0 +1,28 @@
+#pragma once
+// The initial particles of vlasov-poisson-2d: sampled with a seeded generator from a perturbed
+// Maxwellian, or read from a file (a .npy N x 4 array of x1 x2 v1 v2, or the UA-PIC peer's raw
+// little-endian float64 layout, the same four numbers per particle).
+#include <cstdint>
+#include <string>
+
+#include "pic_field.hpp"
+
+namespace tsi::pic {
+
+/// The distributions the model samples.
+enum class Distribution {
+  landau,  ///< density 1 + alpha cos(k_x x1), Maxwellian velocities (unit temperature)
+  peer     ///< the peer's: density 1 + sin(x2) + alpha cos(k_x x1), two streams at v1 = +-2 (truncated to [-5, 5]^2)
+};
+
+/// N particles (x1, x2, v1, v2) at entries 4k .. 4k + 3 of a real vector, by rejection from
+/// the distribution with a 64-bit Mersenne twister seeded with `seed` (the same particles on
+/// every machine with IEEE doubles and a correctly rounded libm).
+RealVector sample_particles(const Geometry& geometry, Distribution distribution, double alpha, std::uint64_t seed);
+
+/// The particles of a file: `.npy` (float64, N x 4 or 4N values), any other name the peer's
+/// raw layout (a multiple of 32 bytes). A tsi::ConfigError naming model.particles for a file
+/// that cannot be read, of the wrong size, or with values that are not finite.
+RealVector read_particles(const std::string& file);
+
+}  // namespace tsi::pic

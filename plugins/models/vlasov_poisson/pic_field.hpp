@@ -1,0 +1,81 @@
+#pragma once
+// The particle-in-cell field of vlasov-poisson-2d (SPEC.md section 7): the charge density
+// deposited from the particles on an n_x x n_y grid of the periodic box [0, 2 pi / k_x) x
+// [0, 2 pi / k_y), -lap phi = rho - mean(rho) solved by FFT, and E = -grad phi interpolated
+// back at the particles with the deposition's own shape function (so that the self-force sums
+// to zero and the total momentum turns with the magnetic field).
+#include <array>
+#include <memory>
+
+#include "tsi/spectral_grid.hpp"
+#include "tsi/types.hpp"
+
+namespace tsi::pic {
+
+/// The shape function of deposition and interpolation: cloud in cell (linear, 2 x 2 nodes) or
+/// the quintic B-spline M6 (6 x 6 nodes; the UA-PIC peer's 7 x 7 stencil, whose outer weight is 0).
+enum class Shape { cic, m6 };
+
+/// The box, its grid and the particles' common weight.
+struct Geometry {
+  int n_x = 16, n_y = 16;
+  double k_x = 0.5, k_y = 1.0;
+  Shape shape = Shape::m6;
+  Index particles = 1;
+
+  double length_x() const;
+  double length_y() const;
+  double dx() const { return length_x() / n_x; }
+  double dy() const { return length_y() / n_y; }
+  /// |box| / N: the particles carry the box's unit mean density between them.
+  double weight() const { return length_x() * length_y() / static_cast<double>(particles); }
+};
+
+/// Where a state column keeps particle k's x1, x2, v1, v2: at base[k * particle_stride +
+/// c * component_stride], c = 0 .. 3 (a real column: strides 4 and 1; a complex one read as
+/// doubles, real parts: 8 and 2).
+struct ParticleLayout {
+  Index particle_stride = 4, component_stride = 1;
+};
+
+/// The nodes and weights of one coordinate: node (first + a) mod n with weight w[a].
+struct Stencil {
+  static constexpr int max_width = 6;
+  int width = 0;
+  std::array<int, max_width> node{};
+  std::array<double, max_width> w{};
+};
+
+/// The stencil of coordinate x (in units of the cell, any real: wrapped into [0, n)).
+Stencil stencil(Shape shape, double x_over_cell, int n);
+
+/// The grid field of one set of particle positions, with its own buffers and transforms (one
+/// per thread of a tau grid).
+class Field {
+ public:
+  explicit Field(const Geometry& geometry);
+  ~Field();
+  Field(const Field&) = delete;
+  Field& operator=(const Field&) = delete;
+
+  /// rho deposited from the positions of the N particles at `base` (layout), then E.
+  void solve(const double* base, ParticleLayout layout);
+  /// E interpolated at (x1, x2).
+  void at(double x1, double x2, double& e1, double& e2) const;
+  /// (1/2) int |E|^2 over the box (the grid's rectangle rule) of the last solve.
+  double field_energy() const;
+  /// int rho over the box before the mean was taken off (N w = |box| when nothing is lost).
+  double charge() const { return charge_; }
+
+ private:
+  Geometry g_;
+  SpectralGrid grid_;  // (n_y, n_x) in C order: x the last direction, halved by the real transforms
+  std::unique_ptr<RealGridTransforms> transforms_;  // 2 columns: rho, then E1 and E2
+  RealVector rho_;
+  const double* e1_ = nullptr;  // E1 and E2 on the grid: the transforms' values after a solve
+  const double* e2_ = nullptr;
+  RealVector k1_, k2_, inverse_k2_;  // per point of the half spectrum
+  double charge_ = 0.0;
+};
+
+}  // namespace tsi::pic
