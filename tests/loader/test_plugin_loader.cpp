@@ -97,7 +97,7 @@ TEST_CASE("loader: the layout handshake covers the exchanged structures") {
   CHECK(layout.address_sanitizer == 0u);
 #endif
   CHECK(layout.scheme.size == sizeof(tsi::Scheme));
-  CHECK(TSI_PLUGIN_ABI_VERSION == 14);  // 4: the remainder, bind_tau_grid, invariants; 5: entry completion, needs_exact_flows; 6: traits from parameters; 7: independent_tau_grid_bindings; 8: bound steppers; 9: real tau grids (TauGridField::evaluate_real), fields, Model::physical_dim, memory of a binding (Scheme::state_vectors, Diagonal, in_place); 10: the run context (Params::context, FftBatch threads); 11: exact solutions (Model::exact_solution, Field::affine_terms); 12: the narrow Model (capabilities: hamiltonian, fused_tau_grid, exact_nonlinear_flow, physical_variables); 13: PhysicalVariables::physical_shape; 14: re-preparation as a state observer (Reformulation::repreparation, no Problem::between_steps)
+  CHECK(TSI_PLUGIN_ABI_VERSION == 14);  // 4: the remainder, bind_tau_grid, invariants; 5: entry completion, needs_exact_flows; 6: traits from parameters; 7: independent_tau_grid_bindings; 8: bound steppers; 9: real tau grids (TauGridField::evaluate_real), fields, Model::physical_dim, memory of a binding (Scheme::state_vectors, Diagonal, in_place); 10: the run context (Params::context, FftBatch threads); 11: exact solutions (Model::exact_solution, Field::affine_terms); 12: the narrow Model (capabilities: hamiltonian, fused_tau_grid, exact_nonlinear_flow, physical_variables); 13: PhysicalVariables::physical_shape; 14: re-preparation as a state observer (Reformulation::repreparation, no Problem::between_steps), the typed selection, VerificationRegime::params
 }
 
 TEST_CASE("loader: a plugin for another tsi major version is refused") {
