@@ -110,18 +110,21 @@ void Direct::model_rhs(const Vector& u, Vector& out) {
   if (remainder_.size()) out += remainder_.cwiseProduct(u);
 }
 
-void Direct::nonlinear(double /*t*/, const Vector& y, Vector& out) {
+void Direct::evaluate(const Vector& y, Vector& out, bool with_linear_part) {
   ++evaluations_;
   const Vector& x = values_of(y);
   Vector& result = packing_.on() ? result_ : out;
+  const auto field = [&](const Vector& u) { with_linear_part ? model_rhs(u, result) : model_nonlinear(u, result); };
   if (!physical_) {
-    model_nonlinear(x, result);
-  } else {
-    model_nonlinear(model_->from_physical(x), result);
+    field(x);
+  } else {  // in the model's variables, read back in the physical ones
+    field(model_->from_physical(x));
     result = model_->to_physical(result);
   }
   store(result, out);
 }
+
+void Direct::nonlinear(double /*t*/, const Vector& y, Vector& out) { evaluate(y, out, false); }
 
 void Direct::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& dy, Vector& out) {
   const Vector x = packing_.unpacked(y), dx = packing_.unpacked(dy);
@@ -131,17 +134,6 @@ void Direct::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& d
   store(physical_ ? model_->to_physical(field_.col(0)) : Vector(field_.col(0)), out);
 }
 
-void Direct::rhs(double /*t*/, const Vector& y, Vector& out) {
-  ++evaluations_;
-  const Vector& x = values_of(y);
-  Vector& result = packing_.on() ? result_ : out;
-  if (!physical_) {
-    model_rhs(x, result);
-  } else {
-    model_rhs(model_->from_physical(x), result);
-    result = model_->to_physical(result);
-  }
-  store(result, out);
-}
+void Direct::rhs(double /*t*/, const Vector& y, Vector& out) { evaluate(y, out, true); }
 
 }  // namespace tsi

@@ -48,6 +48,9 @@ class Direct final : public Reformulation {
   const Vector& values_of(const Vector& y);
   // `values` (d) into out (packed when the packing is on; out may then not be `values`).
   void store(const Vector& values, Vector& out) const;
+  // out = N(y), or L y + N(y) with the linear part: one evaluation, through the packing and the
+  // physical variables.
+  void evaluate(const Vector& y, Vector& out, bool with_linear_part);
   void model_nonlinear(const Vector& u, Vector& out);
   void model_rhs(const Vector& u, Vector& out);
 
