@@ -65,12 +65,7 @@ const Vector& Direct::values_of(const Vector& y) {
 }
 
 void Direct::store(const Vector& values, Vector& out) const {
-  if (!packing_.on()) {
-    if (&out != &values) out = values;
-    return;
-  }
-  out.resize(packing_.size());
-  packing_.pack(values.data(), out.data());
+  if (&out != &values) packing_.pack_into(values.data(), out);
 }
 
 void Direct::linear_flow(double h, Vector& y) {

@@ -40,13 +40,7 @@ void Filtered::load(const Vector& y, Matrix& values) const {
     values.col(0) = y;
 }
 
-void Filtered::store(const Matrix& values, Vector& out) const {
-  out.resize(packing_.size());
-  if (packing_.on())
-    packing_.pack(values.data(), out.data());
-  else
-    out = values.col(0);
-}
+void Filtered::store(const Matrix& values, Vector& out) const { packing_.pack_into(values.data(), out); }
 
 void Filtered::nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) {
   tau_(0) = fast_phase(t, model_->eps());

@@ -1,4 +1,6 @@
 #pragma once
+#include <algorithm>
+
 #include "tsi/types.hpp"
 
 namespace tsi {
@@ -28,6 +30,15 @@ class RealPacking {
       values[2 * k] = packed[k].real();
       if (2 * k + 1 < d_) values[2 * k + 1] = packed[k].imag();
     }
+  }
+  /// The d `values` into `out`, resized to size(): their real parts two to an entry where the
+  /// packing is on, as they stand otherwise.
+  void pack_into(const Complex* values, Vector& out) const {
+    out.resize(size());
+    if (on_)
+      pack(values, out.data());
+    else
+      std::copy(values, values + d_, out.data());
   }
   /// A model state (d values) as a state of the problem.
   Vector packed(const Vector& values) const {

@@ -24,10 +24,9 @@ double Geometry::length_y() const { return two_pi / k_y; }
 Stencil stencil(Shape shape, double x_over_cell, int n) {
   double p = std::fmod(x_over_cell, static_cast<double>(n));
   if (p < 0.0) p += n;
-  double cell = std::floor(p);
+  const double cell = std::floor(p);
   const double d = p - cell;
-  int i = static_cast<int>(cell);
-  if (i >= n) i -= n;  // p rounded up to n
+  const int i = static_cast<int>(cell);  // n when p rounded up to n: the nodes are wrapped below
   Stencil s;
   if (shape == Shape::cic) {
     s.width = 2;

@@ -78,18 +78,10 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   void nonlinear_field(tsi::ConstMatrixRef u, MatrixRef out) const override {
     const std::lock_guard<std::mutex> lock(mutex_);
     Field& field = shared_field();
-    for (Index j = 0; j < u.cols(); ++j) {
-      field.solve(reinterpret_cast<const double*>(u.col(j).data()), complex_layout);
-      for (Index k = 0; k < g_.particles; ++k) {
-        double e1 = 0.0, e2 = 0.0;
-        field.at(u(4 * k, j).real(), u(4 * k + 1, j).real(), e1, e2);
-        const double v1 = u(4 * k + 2, j).real(), v2 = u(4 * k + 3, j).real();
-        out(4 * k, j) = v1;
-        out(4 * k + 1, j) = v2;
-        out(4 * k + 2, j) = e1;
-        out(4 * k + 3, j) = e2;
-      }
-    }
+    // f = f_0 = (v, E(x)): the filtered column at tau = 0, where R(0) = I.
+    for (Index j = 0; j < u.cols(); ++j)
+      filtered_column(field, g_.particles, reinterpret_cast<const double*>(u.col(j).data()), complex_layout, 1.0, 0.0,
+                      [&](Index k, int c, double value) { out(4 * k + c, j) = value; });
   }
 
   void apply_A(const Vector& u, Vector& out) const override {
