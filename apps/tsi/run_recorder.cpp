@@ -64,14 +64,15 @@ RunRecorder::RunRecorder(const Model& model, Reformulation& reformulation, const
     Declared d;
     d.initial = d.final = invariant.value(u0);
     d.relative = std::abs(d.initial) > relative_change_threshold;
-    d.column = (d.relative ? "err_" : "abs_err_") + invariant.name;
+    d.min = d.max = d.initial;
+    d.column = invariant.conserved ? (d.relative ? "err_" : "abs_err_") + invariant.name : invariant.name;
     check_invariant_name(invariant.name, d.column, taken);
     taken.insert({invariant.name, d.column});
     d.invariant = std::move(invariant);
     declared_.push_back(std::move(d));
   }
   csv_.pop_back();  // the header's newline
-  for (const auto& d : declared_) csv_ += "," + d.invariant.name + "," + d.column;
+  for (const auto& d : declared_) csv_ += "," + d.invariant.name + (d.invariant.conserved ? "," + d.column : "");
   csv_ += "\n";
   drift_from_ = 0.1 * static_cast<double>(config["time"]["t_end"]);  // as the study reports have it
   if (!csv_path.empty()) {
@@ -207,6 +208,8 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
     d.final = d.invariant.value(u);
     d.change = std::abs(d.final - d.initial) / (d.relative ? std::abs(d.initial) : 1.0);
     d.max_change = std::max(d.max_change, d.change);
+    d.min = std::min(d.min, d.final);
+    d.max = std::max(d.max, d.final);
   }
   const bool blow_up = errors[0] > max_err_H_;
   if (n % every_ == 0 || n == n_steps_ || blow_up) {
@@ -214,7 +217,8 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
                                                  values[0], values[1], values[2], errors[0], errors[1], errors[2],
                                                  roughness, spread)
                                    : fmt::format("{:.17g},{:.6e},{:.6e}", t, roughness, spread);
-    for (const auto& d : declared_) row += fmt::format(",{:.17g},{:.6e}", d.final, d.change);
+    for (const auto& d : declared_)
+      row += d.invariant.conserved ? fmt::format(",{:.17g},{:.6e}", d.final, d.change) : fmt::format(",{:.17g}", d.final);
     write_row(row + "\n", t);
     if (t >= drift_from_)
       for (int k = 0; hamiltonian_ && k < 3; ++k) {
@@ -240,13 +244,20 @@ Json RunRecorder::invariants_json() const {
     out[names[k]] = {{"initial", tracks_[k].initial},
                      {"final", tracks_[k].final},
                      {"max_rel_error", tracks_[k].max_rel_error}};
-  for (const auto& d : declared_)
+  for (const auto& d : declared_) {
+    if (!d.invariant.conserved) {  // a diagnostic: its range (no column of changes)
+      out[d.invariant.name] = {{"initial", d.initial},     {"final", d.final},
+                               {"min", d.min},             {"max", d.max},
+                               {"conserved", false},       {"description", d.invariant.description}};
+      continue;
+    }
     out[d.invariant.name] = {{"initial", d.initial},
                              {"final", d.final},
                              {"max_change", d.max_change},
                              {"change", d.relative ? "relative" : "absolute"},
                              {"column", d.column},
                              {"description", d.invariant.description}};
+  }
   return out;
 }
 

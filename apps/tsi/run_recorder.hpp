@@ -75,6 +75,7 @@ class RunRecorder {
     bool relative = true;
     std::string column;
     double initial = 0.0, final = 0.0, change = 0.0, max_change = 0.0;
+    double min = 0.0, max = 0.0;  // a diagnostic's range (conserved = false)
   };
   const Model& model_;
   Reformulation& reformulation_;

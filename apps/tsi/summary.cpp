@@ -49,6 +49,11 @@ std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
         s += fmt::format("  {:<24} {:.3e}   ({:.10g} -> {:.10g})\n",
                          fmt::format("max {} change of {}", inv["change"] == "relative" ? "rel." : "abs.", name),
                          inv["max_change"].get<double>(), inv["initial"].get<double>(), inv["final"].get<double>());
+    for (const auto& [name, inv] : r["invariants"].items())  // the model's diagnostics (not conserved)
+      if (inv.contains("conserved") && inv["conserved"] == false)
+        s += fmt::format("  {:<24} {:.6g} .. {:.6g}   ({:.10g} -> {:.10g})\n", fmt::format("range of {}", name),
+                         inv["min"].get<double>(), inv["max"].get<double>(), inv["initial"].get<double>(),
+                         inv["final"].get<double>());
     const Json& sv = r["solver"];
     if (sv["stages"].get<long>() > 0)
       s += fmt::format("  fixed-point sweeps/stage  {:.2f} mean, {} max, {} not converged\n",

@@ -70,7 +70,13 @@ void register_core(Registry& registry) {
        bool_param("real_layout", true,
                   "a real model keeps U(tau) real: the state holds tau modes 0 .. n_tau/2 and the "
                   "transforms are real-to-complex (half the memory); false: all n_tau modes, as for a "
-                  "complex model (the same numbers to rounding)")},
+                  "complex model (the same numbers to rounding)"),
+       string_param("nyquist", "zero",
+                    "the tau Nyquist mode: zero (its multiplier is 0, as the Fourier differentiation matrix "
+                    "has it: SPEC.md) or average (the functions of L there averaged over +-i n_tau/(2 eps), as "
+                    "a naive real-to-complex code takes it: the UA-PIC peer's; the exponential schemes read it, "
+                    "fd does not; breaks exact time symmetry)")
+           .choices({"zero", "average"})},
       ""};
   two_scale.complete = [](Json& p, const Selection& s) {
     if (p["n_tau"].is_null()) p["n_tau"] = s.model.default_n_tau;
@@ -105,8 +111,10 @@ void register_core(Registry& registry) {
                                              : method == "central" ? TwoScale::DataMethod::central
                                                                    : TwoScale::DataMethod::automatic;
     const bool real_layout = !p.has("real_layout") || p.boolean("real_layout");
-    return std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation, data_method, real_layout,
-                                      p.context());
+    auto made = std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation, data_method,
+                                                real_layout, p.context());
+    if (p.has("nyquist") && p.string("nyquist") == "average") made->average_nyquist();
+    return made;
   };
   registry.add_reformulation(std::move(two_scale));
 

@@ -1,5 +1,6 @@
 #pragma once
 #include <span>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -32,12 +33,38 @@ class Diagonal {
     for (Index b = 0; b < values_.size(); ++b) out.segment(b * run_, run_).setConstant(values_(b));
     return out;
   }
+  /// The operator with conjugate pairs: where pairs(b) = p != 0, the entries of stored value b
+  /// (whose value stays values()(b)) have their functions averaged over values()(b) +- i p:
+  /// f there is (f(v + i p) + f(v - i p)) / 2. A tau grid's Nyquist mode taken as a naive
+  /// real-to-complex code takes it (reformulation.nyquist = average); empty: none.
+  Diagonal with_pairs(RealVector pairs) const {
+    Diagonal d = *this;
+    d.pairs_ = std::move(pairs);
+    return d;
+  }
+  /// Per stored value, the conjugate pair's imaginary part (0: none; empty: no pairs).
+  const RealVector& pairs() const { return pairs_; }
+  /// f at stored value b (averaged over its pair where it has one), of the operator scaled by `scale`.
+  template <class F>
+  auto function_at(Index b, double scale, F&& f) const {
+    const Complex v = values_(b);
+    if (pairs_.size() == 0 || pairs_(b) == 0.0) return f(scale * v);
+    auto plus = f(scale * (v + Complex(0.0, pairs_(b))));
+    const auto minus = f(scale * (v - Complex(0.0, pairs_(b))));
+    if constexpr (std::is_same_v<std::decay_t<decltype(plus)>, Complex>) {
+      return Complex(0.5 * (plus + minus));
+    } else {
+      for (size_t j = 0; j < plus.size(); ++j) plus[j] = 0.5 * (plus[j] + minus[j]);
+      return plus;
+    }
+  }
   /// Its memory in vectors of its size (1 / run()).
   double state_fraction() const { return size() ? static_cast<double>(values_.size()) / static_cast<double>(size()) : 0.0; }
 
  private:
   Vector values_;
   Index run_ = 1;
+  RealVector pairs_;  // empty, or one per stored value
 };
 
 /// out_i = f(scale * lambda_i): a function of the diagonal operator scale * L, evaluated
@@ -46,7 +73,7 @@ template <class F>
 void diagonal_function(const Diagonal& lambda, double scale, F&& f, Diagonal& out) {
   const Vector& v = lambda.values();
   Vector values(v.size());
-  for (Index i = 0; i < v.size(); ++i) values(i) = f(scale * v(i));
+  for (Index i = 0; i < v.size(); ++i) values(i) = lambda.function_at(i, scale, f);
   out = Diagonal(std::move(values), lambda.run());
 }
 
@@ -72,7 +99,7 @@ void diagonal_functions(const Diagonal& lambda, double scale, F&& f, std::span<D
   const Vector& v = lambda.values();
   std::vector<Vector> values(outs.size(), Vector(v.size()));
   for (Index i = 0; i < v.size(); ++i) {
-    const auto w = f(scale * v(i));
+    const auto w = lambda.function_at(i, scale, f);
     for (size_t j = 0; j < outs.size(); ++j) values[j](i) = w[j];
   }
   for (size_t j = 0; j < outs.size(); ++j) *outs[j] = Diagonal(std::move(values[j]), lambda.run());

@@ -35,6 +35,14 @@ class TSI_API TauGridField {
   /// same matrix (each column read before it is written): the two-scale problem then evaluates
   /// in the caller's vector and holds no grid buffer of its own.
   virtual bool in_place() const { return false; }
+  /// True when the binding's field also depends on the two-scale state's value on the diagonal,
+  /// U(t, t/eps) (the solution's own filtered value at the evaluation's time): a field frozen
+  /// along tau, as the UA-PIC codes' electric field solved once per evaluation from the
+  /// particles' positions at t. The reformulation then calls set_diagonal before each evaluation.
+  virtual bool needs_diagonal() const { return false; }
+  /// The diagonal value (dim entries) for the evaluation that follows; it stays valid until
+  /// that evaluation returns.
+  virtual void set_diagonal(const Vector& /*diagonal*/) {}
 };
 
 /// The filtered field f_tau(u) = e^{-A tau} f(e^{A tau} u) in one pass instead of the three
@@ -104,11 +112,15 @@ class TSI_API PhysicalVariables {
 };
 
 /// A quantity a model declares as conserved (or nearly) besides H, I and m: runs record its
-/// relative change and plot it (NLS: the momentum; charged particle: the magnetic moment).
+/// relative change and plot it (NLS: the momentum; charged particle: the magnetic moment). Or,
+/// with conserved = false, a quantity recorded as it goes (its values only).
 struct TSI_API ModelInvariant {
   std::string name;         ///< a column name: letters, digits and '_' ("P", "mu")
   std::string description;  ///< one line, for the run's files and plots
   std::function<double(const Vector& u)> value;  ///< of a state in model variables
+  /// false: a diagnostic recorded beside the invariants (the particle-in-cell electric energy):
+  /// its value in each row and its range, no change tracked.
+  bool conserved = true;
 };
 
 /// An exact solution of a model's equation, where the model knows one (the matrix model with

@@ -85,6 +85,8 @@ Matrix PreparedData::r2(const Vector& w) {
 
 Vector PreparedData::at(const Vector& v, double s) {
   order_reached_ = order_;  // the recursions lower it where they stop early
+  phase_ = s;
+  if (method_ == DataMethod::automatic && order_ <= 2 && grid_.real_layout()) return low_order_data(v, s);
   Matrix c;
   if (method_ == DataMethod::central)
     c = central_data(v, s, order_);
@@ -93,6 +95,27 @@ Vector PreparedData::at(const Vector& v, double s) {
   else
     c = closed_data(v, s);
   Vector out = Eigen::Map<const Vector>(c.data(), grid_.size());
+  return out;
+}
+
+Vector PreparedData::low_order_data(const Vector& v, double s) {
+  // Order 2: U = v + eps (r1(v) - r1(v)(s)), r1 = A f_.(v), with f_tau of the constant grid v
+  // evaluated as the state's nonlinearity at the zero state shifted by v; order 1: U = v.
+  Vector out = Vector::Zero(grid_.size());
+  Eigen::Map<Matrix> c(out.data(), dim_, columns_);
+  if (order_ >= 2) {
+    const Vector zero = Vector::Zero(grid_.size());
+    grid_.nonlinear(zero, &v, out, s);
+    for (int j = 0; j < columns_; ++j) {
+      const Complex a = grid_.antiderivative(j);
+      if (a == 0.0)
+        c.col(j).setZero();
+      else
+        c.col(j) *= eps_ * a;
+    }
+    c.col(0) -= grid_.evaluate(c, s);
+  }
+  c.col(0) += v;
   return out;
 }
 
@@ -268,7 +291,7 @@ void PreparedData::trajectory_level(const std::vector<Vector>& points, const std
   const auto phi = [&](int j) { return Eigen::Map<const Matrix>(previous[j].data(), dim_, columns_); };
   for (int i = 0; i < m; ++i) {
     if (only >= 0 && i != only) continue;
-    grid_.nonlinear(previous[i], &points[i], next[i]);  // f at c_i + previous_i(tau)
+    grid_.nonlinear(previous[i], &points[i], next[i], phase_);  // f at c_i + previous_i(tau)
     Eigen::Map<Matrix> rhs(next[i].data(), dim_, columns_);
     drift[i] = rhs.col(0);
     if (remainder_.size()) drift[i] += remainder_.cwiseProduct(points[i]);

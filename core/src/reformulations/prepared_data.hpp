@@ -44,6 +44,10 @@ class PreparedData {
   /// r2(w) = A[Df(w) A f(w)] - A^2[Df(w) (Pi f(w) + JR w)] + JR A^2 f(w), as coefficients
   /// (SPEC.md's r2; the JR terms come from the remainder in the averaged flow).
   Matrix r2(const Vector& w);
+  /// Orders 1 and 2 of the closed formulas in the real layout, directly as a state: the
+  /// field on the real tau grid, no all-mode temporaries (a particle-in-cell state re-prepared
+  /// every step is 10^8 coefficients).
+  Vector low_order_data(const Vector& v, double s);
   /// The closed formulas of SPEC.md (orders 1-3), as coefficients.
   Matrix closed_data(const Vector& v, double s);
   /// The derivative-free recursion (SPEC.md, "Higher order") to `order` with central
@@ -83,6 +87,7 @@ class PreparedData {
   int order_;
   DataMethod method_;
   int order_reached_ = 0;
+  double phase_ = 0.0;  // the centre of the data being prepared: the diagonal of its evaluations
 };
 
 }  // namespace tsi

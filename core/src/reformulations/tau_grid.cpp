@@ -67,6 +67,7 @@ TauGrid::TauGrid(std::shared_ptr<const Model> model, int n_tau, bool real_layout
     fft_ = std::make_unique<FftBatch>(n_tau, rows, threads_, context.fft);
   }
   grid_field_ = model_->bind_tau_grid(taus_);
+  needs_diagonal_ = grid_field_->needs_diagonal();
   for (int p = 0; p <= threads_; ++p) column_begin_.push_back(static_cast<Index>(n_tau) * p / threads_);
   for (int p = 0; threads_ > 1 && p < threads_; ++p)
     column_fields_.push_back(model_->bind_tau_grid(taus_.segment(column_begin_[p], column_begin_[p + 1] - column_begin_[p])));
@@ -88,8 +89,18 @@ bool TauGrid::real_layout_for(const Model& model) {
   return !model.is_complex() && !model.has_linear_remainder();
 }
 
-void TauGrid::nonlinear(const Vector& y, const Vector* mean_shift, Vector& out) {
+void TauGrid::set_diagonal(const Vector& diagonal) {
+  grid_field_->set_diagonal(diagonal);
+  for (auto& field : column_fields_) field->set_diagonal(diagonal);
+}
+
+void TauGrid::nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, double phase) {
   ++*evaluations_;
+  if (needs_diagonal_) {
+    diagonal_ = evaluate(Eigen::Map<const Matrix>(y.data(), dim_, columns_), phase);
+    if (mean_shift) diagonal_ += *mean_shift;
+    set_diagonal(diagonal_);
+  }
   if (real_layout_) return nonlinear_real(y, mean_shift, out);
   if (threads_ > 1) return nonlinear_threaded(y, mean_shift, out);
   // The grid in out's storage: the tau transforms go through their small blocks, and a model
@@ -236,6 +247,10 @@ double TauGrid::coefficient_norm(const Vector& y, bool without_mean) const {
 
 Matrix TauGrid::f_coefficients(Matrix w) {
   ++*evaluations_;
+  if (needs_diagonal_) {
+    diagonal_ = w.col(0);
+    set_diagonal(diagonal_);
+  }
   if (grid_field_->in_place()) {
     grid_field_->evaluate(w, w);
     return to_coefficients(std::move(w));
@@ -248,6 +263,10 @@ Matrix TauGrid::f_coefficients(Matrix w) {
 
 Matrix TauGrid::df_coefficients(Matrix w, Matrix z) {
   ++*evaluations_;
+  if (needs_diagonal_) {
+    diagonal_ = w.col(0);
+    set_diagonal(diagonal_);
+  }
   model_->linear_flow(taus_, w);
   model_->linear_flow(taus_, z);
   Matrix df(dim_, n_tau_);

@@ -41,10 +41,13 @@ class TauGrid {
   /// f_tau(y + mean_shift), coefficients to coefficients in the state's layout: the shift (none:
   /// nullptr) is added to the tau mean on the way to the grid, so the prepared data evaluate f
   /// at c_i + Phi_i without a copy of Phi_i. The grid is formed in out's storage.
-  void nonlinear(const Vector& y, const Vector* mean_shift, Vector& out);
+  /// `phase`: tau on the diagonal at the evaluation's time (t/eps), for a field that reads
+  /// U there (TauGridField::needs_diagonal).
+  void nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, double phase);
 
   /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau), computed in W's storage where
-  /// the model evaluates in place.
+  /// the model evaluates in place. A field that reads the diagonal reads W at tau = 0 (the
+  /// callers' grids are constant in tau, but for central difference data).
   Matrix f_coefficients(Matrix grid);
   /// Coefficients of Df_tau(W(tau)) Z(tau) for grid values W, Z (consumed).
   Matrix df_coefficients(Matrix grid, Matrix direction_grid);
@@ -74,6 +77,8 @@ class TauGrid {
   /// nonlinear on the tau grid split over threads_: each thread transforms its rows and
   /// evaluates the field on its columns (between barriers); the same numbers as the serial path.
   void nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out);
+  /// Hands the diagonal value to every binding (fields that read it only).
+  void set_diagonal(const Vector& diagonal);
   /// A field evaluation on threads_ threads: transform_in(p) and transform_out(p) on part p's
   /// rows, evaluate(p, c0, cn) on its columns [c0, c0 + cn), with barriers between; an
   /// exception from evaluate reaches the caller once every thread has finished.
@@ -92,6 +97,8 @@ class TauGrid {
   int threads_;
   std::vector<Index> column_begin_;  // threads_ + 1 boundaries of the threads' tau columns
   std::vector<std::unique_ptr<TauGridField>> column_fields_;  // f_tau on each thread's columns
+  bool needs_diagonal_ = false;  // the bindings read U on the diagonal
+  Vector diagonal_;
   // Complex layout:
   std::unique_ptr<FftBatch> fft_;  // the tau transforms, both ways, in threads_ parts (from and to the caller's memory)
   Matrix field_;   // the field on the grid where the model does not evaluate in place (first use)

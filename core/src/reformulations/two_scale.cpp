@@ -35,6 +35,18 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
   multipliers_ = Diagonal(std::move(multipliers), run);
 }
 
+void TwoScale::average_nyquist() {
+  const int n_tau = grid_.n_tau(), nyquist = n_tau / 2;
+  const Index run = multipliers_.run();
+  RealVector pairs = RealVector::Zero(multipliers_.values().size());
+  const double k = nyquist / eps_;
+  if (run > 1)
+    pairs(nyquist) = k;
+  else
+    pairs.segment(nyquist * grid_.dim(), grid_.dim()).setConstant(k);
+  multipliers_ = multipliers_.with_pairs(std::move(pairs));
+}
+
 Index TwoScale::diagonal_run(const Model& model) {
   return model_remainder(model).size() == 0 && model.dim() >= min_diagonal_run ? model.dim() : 1;
 }
@@ -47,7 +59,7 @@ double TwoScale::work_vectors(const Model& model, int initial_data_order, const 
   return 1.0 + (remainder ? 2.0 : 0.0) + prepare;
 }
 
-void TwoScale::nonlinear(double /*t*/, const Vector& y, Vector& out) { grid_.nonlinear(y, nullptr, out); }
+void TwoScale::nonlinear(double t, const Vector& y, Vector& out) { grid_.nonlinear(y, nullptr, out, fast_phase(t, eps_)); }
 
 void TwoScale::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& dy, Vector& out) {
   const Index dim = grid_.dim();

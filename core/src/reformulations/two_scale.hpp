@@ -48,6 +48,9 @@ class TwoScale final : public Reformulation, public TwoScaleDiagnostics {
   TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_data_order,
            Repreparation repreparation = {}, DataMethod data_method = DataMethod::automatic,
            bool real_layout = true, const Context& context = {});
+  /// The Nyquist mode's functions of L averaged over +-i (n_tau/2)/eps (reformulation.nyquist =
+  /// average: a naive real-to-complex code's, the UA-PIC peer's); L itself keeps 0 there.
+  void average_nyquist();
 
   Index size() const override { return grid_.size(); }
   /// True when the state holds modes 0 .. N_tau/2 of a real U (the real layout).

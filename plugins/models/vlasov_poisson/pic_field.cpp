@@ -7,13 +7,106 @@
 namespace tsi::pic {
 namespace {
 
-// The quintic B-spline M6 at q >= 0 (support [0, 3)), as the peer writes it.
-double m6(double q) {
-  const auto p5 = [](double a) { return a * a * a * a * a; };
-  if (q < 1.0) return (p5(3.0 - q) - 6.0 * p5(2.0 - q) + 15.0 * p5(1.0 - q)) / 120.0;
-  if (q < 2.0) return (p5(3.0 - q) - 6.0 * p5(2.0 - q)) / 120.0;
-  if (q < 3.0) return p5(3.0 - q) / 120.0;
-  return 0.0;
+double fifth(double z) {
+  const double z2 = z * z;
+  return z2 * z2 * z;
+}
+
+// The weights of the nodes first .. first + W - 1 of a particle at fraction d in [0, 1) of its
+// cell: M6 (the quintic B-spline, as the peer writes it, at distances 2 + d, 1 + d, d, 1 - d,
+// 2 - d, 3 - d) or CIC. Branch-free: the same arithmetic for every particle.
+template <int W>
+void weights(double d, double* w) {
+  if constexpr (W == 2) {
+    w[0] = 1.0 - d;
+    w[1] = d;
+  } else {
+    static_assert(W == 6);
+    constexpr double c = 1.0 / 120.0;
+    const double a = 1.0 - d;
+    const double a5 = fifth(a), d5 = fifth(d), a1 = fifth(1.0 + a), d1 = fifth(1.0 + d);
+    w[0] = a5 * c;
+    w[1] = (a1 - 6.0 * a5) * c;
+    w[2] = (fifth(2.0 + a) - 6.0 * a1 + 15.0 * a5) * c;
+    w[3] = (fifth(2.0 + d) - 6.0 * d1 + 15.0 * d5) * c;
+    w[4] = (d1 - 6.0 * d5) * c;
+    w[5] = d5 * c;
+  }
+}
+
+// The cell of coordinate x (x / h = cell + d, d in [0, 1)), wrapped into 0 .. n - 1. A
+// coordinate that is not finite gets cell 0 and d NaN: its weights, and so E, are NaN too.
+int cell(double x, double inverse_h, int n, double& d) {
+  const double p = x * inverse_h;
+  double i = std::floor(p);
+  d = p - i;
+  if (!(i >= 0.0 && i < n)) {
+    i -= n * std::floor(i / n);
+    if (i >= n) i -= n;
+    if (i < 0.0) i += n;
+    if (!(i >= 0.0 && i < n)) i = 0.0;
+  }
+  return static_cast<int>(i);
+}
+
+struct Located {
+  Index origin;  // the padded index of the stencil's first node
+  double wx[6], wy[6];
+};
+
+template <int W>
+Located locate(double x1, double x2, double inverse_dx, double inverse_dy, int n_x, int n_y, Index padded_x) {
+  Located l;
+  double d1 = 0.0, d2 = 0.0;
+  const int i = cell(x1, inverse_dx, n_x, d1), j = cell(x2, inverse_dy, n_y, d2);
+  weights<W>(d1, l.wx);
+  weights<W>(d2, l.wy);
+  l.origin = static_cast<Index>(j) * padded_x + i;
+  return l;
+}
+
+template <int W>
+void deposit_all(const double* base, ParticleLayout layout, Index particles, double w, double inverse_dx,
+                 double inverse_dy, int n_x, int n_y, Index padded_x, double* rho) {
+  const Index ps = layout.particle_stride, cs = layout.component_stride;
+  for (Index k = 0; k < particles; ++k) {
+    const double* p = base + k * ps;
+    const Located l = locate<W>(p[0], p[cs], inverse_dx, inverse_dy, n_x, n_y, padded_x);
+    for (int b = 0; b < W; ++b) {
+      double* row = rho + l.origin + b * padded_x;
+      const double s = w * l.wy[b];
+      for (int a = 0; a < W; ++a) row[a] += s * l.wx[a];
+    }
+  }
+}
+
+template <int W>
+void interpolate(const Located& l, const double* e1, const double* e2, Index padded_x, double& out1, double& out2) {
+  double acc1[W] = {}, acc2[W] = {};
+  for (int b = 0; b < W; ++b) {
+    const double* r1 = e1 + l.origin + b * padded_x;
+    const double* r2 = e2 + l.origin + b * padded_x;
+    for (int a = 0; a < W; ++a) {
+      acc1[a] += l.wy[b] * r1[a];
+      acc2[a] += l.wy[b] * r2[a];
+    }
+  }
+  out1 = out2 = 0.0;
+  for (int a = 0; a < W; ++a) {
+    out1 += l.wx[a] * acc1[a];
+    out2 += l.wx[a] * acc2[a];
+  }
+}
+
+template <int W>
+void interpolate_all(const double* base, ParticleLayout layout, Index particles, double inverse_dx, double inverse_dy,
+                     int n_x, int n_y, Index padded_x, const double* e1, const double* e2, double* out) {
+  const Index ps = layout.particle_stride, cs = layout.component_stride;
+  for (Index k = 0; k < particles; ++k) {
+    const double* p = base + k * ps;
+    const Located l = locate<W>(p[0], p[cs], inverse_dx, inverse_dy, n_x, n_y, padded_x);
+    interpolate<W>(l, e1, e2, padded_x, out[2 * k], out[2 * k + 1]);
+  }
 }
 
 }  // namespace
@@ -21,36 +114,19 @@ double m6(double q) {
 double Geometry::length_x() const { return two_pi / k_x; }
 double Geometry::length_y() const { return two_pi / k_y; }
 
-Stencil stencil(Shape shape, double x_over_cell, int n) {
-  double p = std::fmod(x_over_cell, static_cast<double>(n));
-  if (p < 0.0) p += n;
-  const double cell = std::floor(p);
-  const double d = p - cell;
-  const int i = static_cast<int>(cell);  // n when p rounded up to n: the nodes are wrapped below
-  Stencil s;
-  if (shape == Shape::cic) {
-    s.width = 2;
-    s.node = {i, i + 1};
-    s.w = {1.0 - d, d};
-  } else {  // nodes i - 2 .. i + 3 at distances 2 + d .. 3 - d
-    s.width = 6;
-    for (int a = 0; a < 6; ++a) {
-      s.node[static_cast<std::size_t>(a)] = i - 2 + a;
-      s.w[static_cast<std::size_t>(a)] = m6(std::abs(static_cast<double>(a - 2) - d));
-    }
-  }
-  for (int a = 0; a < s.width; ++a) {
-    int& node = s.node[static_cast<std::size_t>(a)];
-    node = (node % n + n) % n;
-  }
-  return s;
-}
-
 Field::Field(const Geometry& geometry)
     : g_(geometry),
+      width_(geometry.shape == Shape::cic ? 2 : 6),
+      offset_(geometry.shape == Shape::cic ? 0 : 2),
+      padded_x_(geometry.n_x + width_ - 1),
+      padded_y_(geometry.n_y + width_ - 1),
+      inverse_dx_(1.0 / geometry.dx()),
+      inverse_dy_(1.0 / geometry.dy()),
       grid_({geometry.n_y, geometry.n_x}),
       transforms_(std::make_unique<RealGridTransforms>(grid_, 2)),
-      rho_(RealVector::Zero(grid_.points())) {
+      padded_rho_(RealVector::Zero(padded_x_ * padded_y_)),
+      padded_e1_(RealVector::Zero(padded_x_ * padded_y_)),
+      padded_e2_(RealVector::Zero(padded_x_ * padded_y_)) {
   // Wave numbers of the half spectrum (n_y full, x halved), scaled to the box: E^ = -i k rho^ / |k|^2.
   const Index half = grid_.half_points(), half_x = g_.n_x / 2 + 1;
   k1_.resize(half);
@@ -63,30 +139,35 @@ Field::Field(const Geometry& geometry)
     const double k_squared = k1_(p) * k1_(p) + k2_(p) * k2_(p);
     inverse_k2_(p) = k_squared > 0.0 ? 1.0 / k_squared : 0.0;  // the mean: no field
   }
-  e1_ = transforms_->values().col(0).data();
-  e2_ = transforms_->values().col(1).data();
 }
 
 Field::~Field() = default;
 
-void Field::solve(const double* base, ParticleLayout layout) {
-  rho_.setZero();
-  const double w = g_.weight();
-  for (Index k = 0; k < g_.particles; ++k) {
-    const double* particle = base + k * layout.particle_stride;
-    const Stencil sx = stencil(g_.shape, particle[0] / g_.dx(), g_.n_x);
-    const Stencil sy = stencil(g_.shape, particle[layout.component_stride] / g_.dy(), g_.n_y);
-    for (int b = 0; b < sy.width; ++b) {
-      double* row = rho_.data() + static_cast<Index>(sy.node[static_cast<std::size_t>(b)]) * g_.n_x;
-      const double wy = w * sy.w[static_cast<std::size_t>(b)];
-      for (int a = 0; a < sx.width; ++a) row[sx.node[static_cast<std::size_t>(a)]] += wy * sx.w[static_cast<std::size_t>(a)];
-    }
-  }
-  const double cell = g_.dx() * g_.dy();
-  rho_ /= cell;
-  charge_ = rho_.sum() * cell;
+void Field::deposit(const double* base, ParticleLayout layout) {
+  padded_rho_.setZero();
+  if (width_ == 2)
+    deposit_all<2>(base, layout, g_.particles, g_.weight(), inverse_dx_, inverse_dy_, g_.n_x, g_.n_y, padded_x_,
+                   padded_rho_.data());
+  else
+    deposit_all<6>(base, layout, g_.particles, g_.weight(), inverse_dx_, inverse_dy_, g_.n_x, g_.n_y, padded_x_,
+                   padded_rho_.data());
+  // Fold the padding onto the periodic grid: padded (J, I) is node (J - offset, I - offset) mod n.
   auto values = transforms_->values();
-  values.col(0) = rho_.array() - charge_ / (g_.length_x() * g_.length_y());
+  double* rho = values.col(0).data();
+  values.col(0).setZero();
+  for (Index J = 0; J < padded_y_; ++J) {
+    double* row = rho + ((J - offset_ + g_.n_y) % g_.n_y) * g_.n_x;
+    const double* from = padded_rho_.data() + J * padded_x_;
+    for (Index I = 0; I < padded_x_; ++I) row[(I - offset_ + g_.n_x) % g_.n_x] += from[I];
+  }
+}
+
+void Field::poisson() {
+  auto values = transforms_->values();
+  const double cell = g_.dx() * g_.dy();
+  values.col(0) /= cell;
+  charge_ = values.col(0).sum() * cell;
+  values.col(0).array() -= charge_ / (g_.length_x() * g_.length_y());
   values.col(1).setZero();
   transforms_->forward();
   auto spectrum = transforms_->spectrum();
@@ -97,31 +178,69 @@ void Field::solve(const double* base, ParticleLayout layout) {
     spectrum(p, 1) = Complex(0.0, -k2_(p)) * rho_hat;
   }
   transforms_->backward();
+  padded_current_ = false;
 }
 
-void Field::at(double x1, double x2, double& e1, double& e2) const {
-  const Stencil sx = stencil(g_.shape, x1 / g_.dx(), g_.n_x);
-  const Stencil sy = stencil(g_.shape, x2 / g_.dy(), g_.n_y);
-  const double* f1 = e1_;
-  const double* f2 = e2_;
-  e1 = e2 = 0.0;
-  for (int b = 0; b < sy.width; ++b) {
-    const Index row = static_cast<Index>(sy.node[static_cast<std::size_t>(b)]) * g_.n_x;
-    double r1 = 0.0, r2 = 0.0;
-    for (int a = 0; a < sx.width; ++a) {
-      const Index node = row + sx.node[static_cast<std::size_t>(a)];
-      r1 += sx.w[static_cast<std::size_t>(a)] * f1[node];
-      r2 += sx.w[static_cast<std::size_t>(a)] * f2[node];
+void Field::pad_field() {
+  if (padded_current_) return;
+  auto values = transforms_->values();
+  const double* e1 = values.col(0).data();
+  const double* e2 = values.col(1).data();
+  for (Index J = 0; J < padded_y_; ++J) {
+    const Index row = ((J - offset_ + g_.n_y) % g_.n_y) * g_.n_x;
+    for (Index I = 0; I < padded_x_; ++I) {
+      const Index node = row + (I - offset_ + g_.n_x) % g_.n_x;
+      padded_e1_(J * padded_x_ + I) = e1[node];
+      padded_e2_(J * padded_x_ + I) = e2[node];
     }
-    e1 += sy.w[static_cast<std::size_t>(b)] * r1;
-    e2 += sy.w[static_cast<std::size_t>(b)] * r2;
   }
+  padded_current_ = true;
+}
+
+void Field::solve(const double* base, ParticleLayout layout) {
+  deposit(base, layout);
+  poisson();
+  at_valid_ = false;
+}
+
+bool Field::same_positions(const double* base, ParticleLayout layout) const {
+  if (!at_valid_) return false;
+  const Index ps = layout.particle_stride, cs = layout.component_stride;
+  for (Index k = 0; k < g_.particles; ++k)
+    if (base[k * ps] != x_at_(2 * k) || base[k * ps + cs] != x_at_(2 * k + 1)) return false;
+  return true;
+}
+
+const double* Field::interpolate(const double* base, ParticleLayout layout) {
+  pad_field();
+  e_at_.resize(2 * g_.particles);
+  if (width_ == 2)
+    interpolate_all<2>(base, layout, g_.particles, inverse_dx_, inverse_dy_, g_.n_x, g_.n_y, padded_x_,
+                       padded_e1_.data(), padded_e2_.data(), e_at_.data());
+  else
+    interpolate_all<6>(base, layout, g_.particles, inverse_dx_, inverse_dy_, g_.n_x, g_.n_y, padded_x_,
+                       padded_e1_.data(), padded_e2_.data(), e_at_.data());
+  at_valid_ = false;  // E of another set of positions' field
+  return e_at_.data();
+}
+
+const double* Field::at_particles(const double* base, ParticleLayout layout) {
+  if (same_positions(base, layout)) return e_at_.data();
+  solve(base, layout);
+  interpolate(base, layout);
+  x_at_.resize(2 * g_.particles);
+  const Index ps = layout.particle_stride, cs = layout.component_stride;
+  for (Index k = 0; k < g_.particles; ++k) {
+    x_at_(2 * k) = base[k * ps];
+    x_at_(2 * k + 1) = base[k * ps + cs];
+  }
+  at_valid_ = true;
+  return e_at_.data();
 }
 
 double Field::field_energy() const {
-  const Index points = grid_.points();
-  return 0.5 * (Eigen::Map<const RealVector>(e1_, points).squaredNorm() + Eigen::Map<const RealVector>(e2_, points).squaredNorm()) *
-         g_.dx() * g_.dy();
+  auto values = transforms_->values();
+  return 0.5 * values.squaredNorm() * g_.dx() * g_.dy();
 }
 
 }  // namespace tsi::pic

@@ -38,19 +38,11 @@ struct ParticleLayout {
   Index particle_stride = 4, component_stride = 1;
 };
 
-/// The nodes and weights of one coordinate: node (first + a) mod n with weight w[a].
-struct Stencil {
-  static constexpr int max_width = 6;
-  int width = 0;
-  std::array<int, max_width> node{};
-  std::array<double, max_width> w{};
-};
-
-/// The stencil of coordinate x (in units of the cell, any real: wrapped into [0, n)).
-Stencil stencil(Shape shape, double x_over_cell, int n);
-
 /// The grid field of one set of particle positions, with its own buffers and transforms (one
-/// per thread of a tau grid).
+/// per thread of a tau grid). Deposition and interpolation work on grids padded by the
+/// stencil's width (the nodes of a particle are contiguous there, never wrapped one by one);
+/// the padding is folded onto the periodic grid after a deposition and filled from it before
+/// an interpolation.
 class Field {
  public:
   explicit Field(const Geometry& geometry);
@@ -60,21 +52,34 @@ class Field {
 
   /// rho deposited from the positions of the N particles at `base` (layout), then E.
   void solve(const double* base, ParticleLayout layout);
-  /// E interpolated at (x1, x2).
-  void at(double x1, double x2, double& e1, double& e2) const;
+  /// E at each of the N particles at `base`: (E1, E2) of particle k at 2k, 2k + 1, from the
+  /// field of these same positions. Positions equal to the last call's reuse its values (the
+  /// columns of prepared data of order 1 share theirs).
+  const double* at_particles(const double* base, ParticleLayout layout);
+  /// E of the last solve at each of the N particles at `base` (as at_particles' values).
+  const double* interpolate(const double* base, ParticleLayout layout);
   /// (1/2) int |E|^2 over the box (the grid's rectangle rule) of the last solve.
   double field_energy() const;
   /// int rho over the box before the mean was taken off (N w = |box| when nothing is lost).
   double charge() const { return charge_; }
 
  private:
+  void deposit(const double* base, ParticleLayout layout);
+  void poisson();
+  void pad_field();
+  bool same_positions(const double* base, ParticleLayout layout) const;
+
   Geometry g_;
+  int width_, offset_;          // stencil nodes first - offset .. first - offset + width - 1
+  Index padded_x_, padded_y_;   // n + width - 1
+  double inverse_dx_, inverse_dy_;
   SpectralGrid grid_;  // (n_y, n_x) in C order: x the last direction, halved by the real transforms
   std::unique_ptr<RealGridTransforms> transforms_;  // 2 columns: rho, then E1 and E2
-  RealVector rho_;
-  const double* e1_ = nullptr;  // E1 and E2 on the grid: the transforms' values after a solve
-  const double* e2_ = nullptr;
+  RealVector padded_rho_, padded_e1_, padded_e2_;  // padded_y x padded_x, x fastest
+  bool padded_current_ = false;                    // padded E is the last solve's
   RealVector k1_, k2_, inverse_k2_;  // per point of the half spectrum
+  RealVector e_at_, x_at_;           // at_particles: E and the positions it was computed at
+  bool at_valid_ = false;
   double charge_ = 0.0;
 };
 

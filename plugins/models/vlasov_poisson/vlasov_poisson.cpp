@@ -14,6 +14,7 @@
 
 #include "particles.hpp"
 #include "pic_field.hpp"
+#include "tsi/error.hpp"
 #include "tsi/model.hpp"
 #include "tsi/params.hpp"
 #include "tsi/plugin.hpp"
@@ -33,19 +34,15 @@ static_assert(std::endian::native == std::endian::little, "the peer's raw partic
 constexpr ParticleLayout complex_layout{8, 2};
 constexpr ParticleLayout real_layout{4, 1};
 
-// f_tau at one phase (cos, sin) for the particles of one column: rho and E from their
-// positions, then (R(tau) y, R(-tau) E(x)) per particle, each particle's values read before
-// its outputs are written (so that out may be the column itself).
+// f_tau at one phase (cos, sin) for the particles of one column, given E at them:
+// (R(tau) y, R(-tau) E) per particle (E is computed before, so out may be the column itself).
 template <class Write>
-void filtered_column(Field& field, Index particles, const double* u, ParticleLayout layout, double c, double s,
+void filtered_column(const double* e, Index particles, const double* u, ParticleLayout layout, double c, double s,
                      Write&& write) {
-  field.solve(u, layout);
   const Index ps = layout.particle_stride, cs = layout.component_stride;
   for (Index k = 0; k < particles; ++k) {
     const double* p = u + k * ps;
-    const double x1 = p[0], x2 = p[cs], y1 = p[2 * cs], y2 = p[3 * cs];
-    double e1 = 0.0, e2 = 0.0;
-    field.at(x1, x2, e1, e2);
+    const double y1 = p[2 * cs], y2 = p[3 * cs], e1 = e[2 * k], e2 = e[2 * k + 1];
     write(k, 0, c * y1 + s * y2);
     write(k, 1, -s * y1 + c * y2);
     write(k, 2, c * e1 - s * e2);
@@ -53,10 +50,16 @@ void filtered_column(Field& field, Index particles, const double* u, ParticleLay
   }
 }
 
+// Which field a tau column's particles feel: the field of that column's own positions (the
+// two-scale problem of the equation as written: one deposition and solve per tau point), or
+// the field of the positions on the diagonal, U(t, t/eps), the particles' actual positions at
+// t, frozen along tau (the UA-PIC codes': one deposition and solve per evaluation).
+enum class TauField { per_tau, diagonal };
+
 class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, public tsi::PhysicalVariables {
  public:
-  VlasovPoisson2d(double eps, Geometry geometry, tsi::RealVector particles)
-      : Model(eps), g_(geometry), u0_(std::move(particles)) {}
+  VlasovPoisson2d(double eps, Geometry geometry, TauField tau_field, tsi::RealVector particles)
+      : Model(eps), g_(geometry), tau_field_(tau_field), u0_(std::move(particles)) {}
 
   const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
   const tsi::PhysicalVariables* physical_variables() const override { return this; }
@@ -80,8 +83,11 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
     Field& field = shared_field();
     // f = f_0 = (v, E(x)): the filtered column at tau = 0, where R(0) = I.
     for (Index j = 0; j < u.cols(); ++j)
-      filtered_column(field, g_.particles, reinterpret_cast<const double*>(u.col(j).data()), complex_layout, 1.0, 0.0,
+    {
+      const double* column = reinterpret_cast<const double*>(u.col(j).data());
+      filtered_column(field.at_particles(column, complex_layout), g_.particles, column, complex_layout, 1.0, 0.0,
                       [&](Index k, int c, double value) { out(4 * k + c, j) = value; });
+    }
   }
 
   void apply_A(const Vector& u, Vector& out) const override {
@@ -98,30 +104,51 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   /// f_tau bound to a tau grid: its own field (buffers and transforms) and rotation tables.
   class GridField final : public tsi::TauGridField {
    public:
-    GridField(const Geometry& g, const tsi::RealVector& taus)
-        : g_(g), field_(g), cos_(taus.array().cos()), sin_(taus.array().sin()) {}
+    GridField(const Geometry& g, TauField tau_field, const tsi::RealVector& taus)
+        : g_(g), tau_field_(tau_field), field_(g), cos_(taus.array().cos()), sin_(taus.array().sin()) {}
     void evaluate(MatrixRef u, MatrixRef out) override {
-      for (Index j = 0; j < u.cols(); ++j)
-        filtered_column(field_, g_.particles, reinterpret_cast<const double*>(u.col(j).data()), complex_layout,
-                        cos_(j), sin_(j), [&](Index k, int c, double value) { out(4 * k + c, j) = value; });
+      for (Index j = 0; j < u.cols(); ++j) {
+        const double* column = reinterpret_cast<const double*>(u.col(j).data());
+        filtered_column(e_at(column, complex_layout), g_.particles, column, complex_layout, cos_(j), sin_(j),
+                        [&](Index k, int c, double value) { out(4 * k + c, j) = value; });
+      }
     }
     bool evaluates_real() const override { return true; }
-    bool in_place() const override { return true; }  // the deposition reads every position first
+    bool in_place() const override { return true; }  // E is computed from every position first
     void evaluate_real(tsi::RealMatrixRef u, tsi::RealMatrixRef out) override {
       for (Index j = 0; j < u.cols(); ++j) {
         double* o = out.col(j).data();
-        filtered_column(field_, g_.particles, u.col(j).data(), real_layout, cos_(j), sin_(j),
-                        [o](Index k, int c, double value) { o[4 * k + c] = value; });
+        filtered_column(e_at(u.col(j).data(), real_layout), g_.particles, u.col(j).data(), real_layout, cos_(j),
+                        sin_(j), [o](Index k, int c, double value) { o[4 * k + c] = value; });
       }
+    }
+    bool needs_diagonal() const override { return tau_field_ == TauField::diagonal; }
+    void set_diagonal(const Vector& diagonal) override {
+      diagonal_ = &diagonal;
+      diagonal_solved_ = false;
     }
 
    private:
+    // E at the particles of one column: from their own field, or from the diagonal's.
+    const double* e_at(const double* column, ParticleLayout layout) {
+      if (tau_field_ == TauField::per_tau) return field_.at_particles(column, layout);
+      if (!diagonal_) throw tsi::Error("vlasov-poisson-2d: the diagonal field was evaluated without the diagonal");
+      if (!diagonal_solved_) {
+        field_.solve(reinterpret_cast<const double*>(diagonal_->data()), complex_layout);
+        diagonal_solved_ = true;
+      }
+      return field_.interpolate(column, layout);
+    }
+
     Geometry g_;
+    TauField tau_field_;
     Field field_;
     tsi::RealVector cos_, sin_;
+    const Vector* diagonal_ = nullptr;
+    bool diagonal_solved_ = false;
   };
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
-    return std::make_unique<GridField>(g_, taus);
+    return std::make_unique<GridField>(g_, tau_field_, taus);
   }
   bool independent_tau_grid_bindings() const override { return true; }
   /// The filtered problem's f_tau, phases per call: through the model's one field (a binding
@@ -130,8 +157,11 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
     const std::lock_guard<std::mutex> lock(mutex_);
     Field& field = shared_field();
     for (Index j = 0; j < u.cols(); ++j)
-      filtered_column(field, g_.particles, reinterpret_cast<const double*>(u.col(j).data()), complex_layout,
+    {
+      const double* column = reinterpret_cast<const double*>(u.col(j).data());
+      filtered_column(field.at_particles(column, complex_layout), g_.particles, column, complex_layout,
                       std::cos(taus(j)), std::sin(taus(j)), [&](Index k, int c, double value) { out(4 * k + c, j) = value; });
+    }
   }
 
   // The physical variables are the model's; the state is an N x 4 array in files.
@@ -170,7 +200,15 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
            Field& field = shared_field();
            field.solve(reinterpret_cast<const double*>(u.data()), complex_layout);
            return field.charge();
-         }}};
+         }},
+        {"W_E", "electric energy (1/2) int |E|^2 (exchanged with the kinetic energy: Landau damping, instabilities)",
+         [this](const Vector& u) {
+           const std::lock_guard<std::mutex> lock(mutex_);
+           Field& field = shared_field();
+           field.solve(reinterpret_cast<const double*>(u.data()), complex_layout);
+           return field.field_energy();
+         },
+         false}};
   }
 
  private:
@@ -182,6 +220,7 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   }
 
   Geometry g_;
+  TauField tau_field_;
   tsi::RealVector u0_;
   mutable std::mutex mutex_;
   mutable std::unique_ptr<Field> field_;
@@ -222,7 +261,12 @@ void register_vlasov_poisson(tsi::Registry& registry) {
           .choices({"landau", "peer"}),
       tsi::number_param("alpha", 0.05, "the density's perturbation").range(0.0, 1.0),
       tsi::integer_param("seed", 1, "the sampling's seed")
-          .check([](const tsi::Json& v) { return v.get<long>() >= 0; }, "a non-negative integer")};
+          .check([](const tsi::Json& v) { return v.get<long>() >= 0; }, "a non-negative integer"),
+      tsi::string_param("tau_field", "per-tau",
+                        "the field a two-scale tau column feels: per-tau (the field of the column's own positions, "
+                        "a deposition and Poisson solve per tau point) or diagonal (the field of the particles' "
+                        "positions at t, U(t, t/eps), frozen along tau: one solve per evaluation, the UA-PIC codes')")
+          .choices({"per-tau", "diagonal"})};
   entry.default_n_tau = 16;
   entry.nonlinearity_degree = 0;  // E(x) is not a polynomial
   // A small plasma on a coarse grid: the orders of every scheme in seconds. The tau grid must
@@ -247,7 +291,8 @@ void register_vlasov_poisson(tsi::Registry& registry) {
           p.string("distribution") == "peer" ? tsi::pic::Distribution::peer : tsi::pic::Distribution::landau;
       particles = tsi::pic::sample_particles(g, distribution, p.number("alpha"), static_cast<std::uint64_t>(p.integer("seed")));
     }
-    return std::make_unique<VlasovPoisson2d>(p.number("eps"), g, std::move(particles));
+    const TauField tau_field = p.string("tau_field") == "diagonal" ? TauField::diagonal : TauField::per_tau;
+    return std::make_unique<VlasovPoisson2d>(p.number("eps"), g, tau_field, std::move(particles));
   };
   registry.add_model(std::move(entry));
 }
