@@ -104,6 +104,11 @@ const ParamSchema& output_schema() {
                    "richardson: estimate the error of u(t_end) without a reference, from the same run at h / 2 "
                    "and 2 h (2.5 times the run's cost more; t_end / h even): result.json's error_estimate")
           .choices({"none", "richardson"}),
+      integer_param("state_every", 0,
+                    "write the state (physical variables, as u_final.npy) to state.npy in the output directory every "
+                    "this many steps, replacing the last (0: never): a long run can be resumed from it "
+                    "(vlasov-poisson-2d: model.particles)")
+          .check([](const Json& v) { return v.get<long>() >= 0; }, "a non-negative integer"),
       number_param("checkpoint_seconds", 30.0,
                    "rewrite result.json (status running, the time reached) at most this often while a run goes")
           .range(0.0, 1e9, true, false),

@@ -426,6 +426,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   std::string status = "completed";
   auto last_progress = Clock::now(), last_checkpoint = Clock::now();
   const double checkpoint_seconds = config.contains("output") ? config["output"].value("checkpoint_seconds", 30.0) : 30.0;
+  const long state_every = config.contains("output") ? config["output"].value("state_every", 0L) : 0L;
   // A checkpoint: result.json says how far the run got, so that a kill -9 or a power cut
   // leaves, besides the streamed rows, a record of the run (replaced by the full one at the end).
   const auto checkpoint = [&](long n, double t) {
@@ -466,6 +467,16 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
       if (progress && seconds_since(last_progress) > 0.5) {
         progress(static_cast<double>(n) / static_cast<double>(std::max(1L, n_steps)), "run");
         last_progress = Clock::now();
+      }
+      if (go_on && state_every > 0 && !stream_dir.empty() && (n % state_every == 0 || n == n_steps)) {
+        // The state as a file a run can start from (written to a temporary file, then renamed),
+        // and result.json's checkpoint says at which time it is.
+        const Vector x = model->to_physical(reformulation->read_back(state, t));
+        std::vector<std::uint64_t> shape;
+        for (const Index d : model->physical_shape()) shape.push_back(static_cast<std::uint64_t>(d));
+        write_npy(stream_dir + "/state.npy", x, model->is_complex(), shape);
+        result["state"] = {{"file", "state.npy"}, {"t", t}, {"step", n}};
+        checkpoint(n, t);
       }
       if (go_on && !stream_dir.empty() && seconds_since(last_checkpoint) > checkpoint_seconds) checkpoint(n, t);
       return go_on;

@@ -207,6 +207,28 @@ TEST_CASE("vlasov-poisson-2d: particles from a .npy N x 4 array and from the pee
                        doctest::Contains("model.particles"), tsi::ConfigError);
   CHECK_THROWS_WITH_AS(h.model_with("vlasov-poisson-2d", 0.1, {{"particles", (dir / "missing.bin").string()}}),
                        doctest::Contains("model.particles"), tsi::ConfigError);
+  // Non-finite values, and a position more than a box length outside the box (the default box
+  // is [0, 4 pi) x [0, 2 pi)), name the particle and the coordinate; 11.9 + 4 pi, carried out
+  // by a run, is kept.
+  const auto refused = [&](Index at, double value, const char* expected) {
+    std::vector<double> changed = values;
+    changed[static_cast<std::size_t>(at)] = value;
+    const std::string file = (dir / "changed.npy").string();
+    tsi::write_npy(file, std::span<const double>(changed), {3, 4});
+    CHECK_THROWS_WITH_AS(h.model_with("vlasov-poisson-2d", 0.1, {{"particles", file}}), doctest::Contains(expected),
+                         tsi::ConfigError);
+  };
+  refused(5, std::nan(""), "particle 1 has x2 = nan");
+  refused(7, INFINITY, "particle 1 has v2 = inf");
+  refused(8, 3.0 * 4.0 * pi, "particle 2 has x1 = 37.69");
+  refused(1, -6.3, "particle 0 has x2 = -6.2999");
+  {
+    std::vector<double> carried = values;
+    carried[8] += 4.0 * pi;
+    const std::string file = (dir / "carried.npy").string();
+    tsi::write_npy(file, std::span<const double>(carried), {3, 4});
+    CHECK(h.model_with("vlasov-poisson-2d", 0.1, {{"particles", file}})->initial_value()(8) == carried[8]);
+  }
   std::filesystem::remove_all(dir);
 }
 

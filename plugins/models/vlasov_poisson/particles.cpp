@@ -101,4 +101,20 @@ RealVector read_particles(const std::string& file) {
   return u;
 }
 
+void check_positions(const RealVector& u, const Geometry& geometry, const std::string& file) {
+  const double lengths[2] = {geometry.length_x(), geometry.length_y()};
+  for (Index k = 0; k < u.size() / 4; ++k)
+    for (int c = 0; c < 2; ++c) {
+      const double x = u(4 * k + c), length = lengths[c];
+      if (x >= -length && x < 2.0 * length) continue;
+      std::ostringstream what;
+      what.precision(17);
+      what << file << ": particle " << k << " has x" << c + 1 << " = " << x << ", outside [-L, 2L) for the box [0, L) = [0, "
+           << length << ") (k_" << (c == 0 ? "x" : "y") << " = " << (c == 0 ? geometry.k_x : geometry.k_y)
+           << "); expected positions in the box, or carried out of it by a run by less than its length (a file in "
+              "other units, or of another box?)";
+      throw ConfigError("model.particles", what.str());
+    }
+}
+
 }  // namespace tsi::pic

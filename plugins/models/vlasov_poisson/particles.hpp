@@ -25,4 +25,10 @@ RealVector sample_particles(const Geometry& geometry, Distribution distribution,
 /// that cannot be read, of the wrong size, or with values that are not finite.
 RealVector read_particles(const std::string& file);
 
+/// Refuses (a tsi::ConfigError naming model.particles) particles whose positions are farther
+/// than one box length outside the box, [-L, 2L) per coordinate: a file in other units or of
+/// another box. Positions a run has carried out of the box (tsi and the peer keep them
+/// unwrapped) stay within that and are kept as they are.
+void check_positions(const RealVector& u, const Geometry& geometry, const std::string& file);
+
 }  // namespace tsi::pic

@@ -75,7 +75,8 @@ class Field {
   double inverse_dx_, inverse_dy_;
   SpectralGrid grid_;  // (n_y, n_x) in C order: x the last direction, halved by the real transforms
   std::unique_ptr<RealGridTransforms> transforms_;  // 2 columns: rho, then E1 and E2
-  RealVector padded_rho_, padded_e1_, padded_e2_;  // padded_y x padded_x, x fastest
+  RealVector padded_rho_;  // padded_y x padded_x, x fastest
+  RealVector padded_e_;    // the same points, (E1, E2) pairs
   bool padded_current_ = false;                    // padded E is the last solve's
   RealVector k1_, k2_, inverse_k2_;  // per point of the half spectrum
   RealVector e_at_, x_at_;           // at_particles: E and the positions it was computed at

@@ -285,6 +285,7 @@ void register_vlasov_poisson(tsi::Registry& registry) {
     if (given.is_string()) {
       particles = tsi::pic::read_particles(given.get<std::string>());
       g.particles = particles.size() / 4;
+      tsi::pic::check_positions(particles, g, given.get<std::string>());
     } else {
       g.particles = static_cast<Index>(given.get<double>());
       const auto distribution =
