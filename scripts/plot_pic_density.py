@@ -20,7 +20,7 @@ output at t = 0 only the final density is drawn. `--initial FILE.npy` names an N
 draw as the initial density instead.
 
 Default output: RUN_DIR/density.png. Exit code 2, with a message naming the file and what was
-expected, for a missing or unexpected file.
+expected, for a missing or unexpected file; 3 when the figure cannot be written.
 """
 import argparse
 import json
@@ -88,9 +88,12 @@ def as_particles(values, name):
 
 def load_npy(path):
     try:
+        with open(path, "rb") as f:
+            if f.read(6) != b"\x93NUMPY":
+                raise BadInput(f"{path}: not a .npy file (no NumPy header; expected an N x 4 float64 array)")
         return np.load(path, allow_pickle=False)
     except (OSError, ValueError) as e:
-        raise BadInput(f"{path}: not a readable .npy file ({e})")
+        raise BadInput(f"{path}: not a readable .npy file ({e}; expected an N x 4 float64 array)")
 
 
 def final_particles(run_dir, result):
@@ -148,18 +151,23 @@ def density_figure(result, final, initial=None, initial_source=""):
     grids = [density(u, model) for u, _ in panels]
     vmax = max(float(g[0].max()) for g in grids)
     lx, ly = 2 * math.pi / model["k_x"], 2 * math.pi / model["k_y"]
-    width = 5.2 * lx / ly + 1.6
-    fig, axes = plt.subplots(1, len(panels), figsize=(width * len(panels), 4.6), squeeze=False)
-    for ax, (rho, ex, ey), (_, label) in zip(axes[0], grids, panels):
+    # A panel 3.4 inches high and as wide as the box (plus its colour bar); panels side by side
+    # for a box about square or tall, one above the other for a wide one.
+    aspect = lx / ly
+    pw, ph = 3.4 * aspect + 1.6, 3.4 + 0.9
+    stacked = aspect > 1.3 and len(panels) > 1
+    shape = (len(panels), 1) if stacked else (1, len(panels))
+    fig, axes = plt.subplots(*shape, figsize=(pw * shape[1], ph * shape[0] + 0.4), squeeze=False,
+                             constrained_layout=True)
+    for ax, (rho, ex, ey), (_, label) in zip(axes.flat, grids, panels):
         mesh = ax.pcolormesh(ex, ey, rho.T, cmap="viridis", vmin=0.0, vmax=vmax, shading="flat")
         ax.set(xlabel="x1", ylabel="x2", xlim=(0, lx), ylim=(0, ly), title=label)
         ax.set_aspect("equal")
-        fig.colorbar(mesh, ax=ax, label="density (uniform = 1)", shrink=0.85)
+        fig.colorbar(mesh, ax=ax, label="density (uniform = 1)", shrink=0.9)
     distribution = model.get("distribution", "") if not isinstance(model.get("particles"), str) else "from a file"
-    fig.suptitle(f"{MODEL}: particle density on {model['n_x']} x {model['n_y']} cells, "
+    fig.suptitle(f"{MODEL}: particle density on {model['n_x']} x {model['n_y']} cells\n"
                  f"eps = {model['eps']:g}, t_end = {result.get('t_end', t):g}, N = {len(final)} "
                  f"({distribution})", fontsize=10)
-    fig.tight_layout()
     return fig
 
 
@@ -179,12 +187,11 @@ def main(argv=None):
         if args.initial:
             if not os.path.isfile(args.initial):
                 raise BadInput(f"{args.initial}: not found (expected an N x 4 .npy file of particles)")
-            initial, source = as_particles(load_npy(args.initial), args.initial), os.path.basename(args.initial)
+            initial, source = as_particles(load_npy(args.initial), args.initial), args.initial
         else:
             initial, source = initial_particles(args.run_dir, result)
         if initial is None:
             print(f"  no initial density: {source}")
-            initial = None
         elif len(initial) != len(final):
             raise BadInput(f"initial particles ({source}): {len(initial)}, expected as many as "
                            f"u_final.npy's {len(final)}")

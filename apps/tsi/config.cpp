@@ -135,7 +135,7 @@ const ParamSchema& monitor_schema() {
           .range(0.0, 1.0, true),
       number_param("tau_spread_growth_warn", 100.0,
                    "warn when the fraction of the energy of U away from its tau mean grows this many times "
-                   "over its value after the first step (and above 1e-6): U's characteristics have come apart")
+                   "over its value at the first recorded step (and above 1e-6): U's characteristics have come apart")
           .range(1.0, std::numeric_limits<double>::infinity())};
   return schema;
 }

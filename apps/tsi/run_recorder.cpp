@@ -190,12 +190,15 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
   // stays far below tau_roughness_warn.
   const double spread = tau ? tau->tau_spread(y) : 0.0;
   spread_max_ = std::max(spread_max_, spread);
-  if (n == 1) spread_baseline_ = spread;
-  if (n > 1 && !spread_warned_ && spread > 1e-6 && spread > spread_growth_warn_ * spread_baseline_) {
+  // The baseline is the first recorded step's spread (step output.every, not always step 1).
+  if (!spread_baseline_set_) {
+    spread_baseline_ = spread;
+    spread_baseline_set_ = true;
+  } else if (!spread_warned_ && spread > 1e-6 && spread > spread_growth_warn_ * spread_baseline_) {
     spread_warned_ = true;
     warnings_.push_back(fmt::format(
         "the tau profile of U lost its coherence at t = {:.6g}: the fraction of its energy away from the "
-        "tau mean grew from {:.2e} after the first step to {:.2e} (monitor.tau_spread_growth_warn = {:g}); "
+        "tau mean grew from {:.2e} at the first recorded step to {:.2e} (monitor.tau_spread_growth_warn = {:g}); "
         "the characteristics of U have come apart, so the solution past this time mixes different "
         "trajectories and its error and invariants may be far off (seen over long times for eps >= 0.1, "
         "or with large h; a smaller h or another scheme may delay it)",

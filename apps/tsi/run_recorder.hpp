@@ -87,6 +87,7 @@ class RunRecorder {
   Vector u_;
   long steps_ = 0;
   double t_ = 0.0, roughness_max_ = 0.0, spread_max_ = 0.0, spread_baseline_ = 0.0;
+  bool spread_baseline_set_ = false;
   bool roughness_warned_ = false, spread_warned_ = false;
   std::string status_ = "running", message_, csv_;
   // Streaming: whole rows wait in pending_ and go to the file descriptor together; written_

@@ -1,5 +1,5 @@
 // Every run config in examples/ runs to completion and meets its reference; every study (in
-// examples/paper/, examples/long-time/ and examples/general/, and a file with a "kind" in examples/) expands (all its runs resolve) without
+// examples/paper/, examples/long-time/ and examples/general/, and a file with a "kind" in examples/ or examples/pic/) expands (all its runs resolve) without
 // running. New examples are picked up by the glob, so an example cannot rot unnoticed.
 #include <doctest/doctest.h>
 
@@ -55,6 +55,8 @@ TEST_CASE("examples: every study expands, and a bad path in one is caught") {
     if (is_study(file)) files.push_back(file);
   for (const auto& file : json_files(fs::path(TSI_TEST_SOURCE_DIR) / "examples" / "long-time")) files.push_back(file);
   for (const auto& file : json_files(fs::path(TSI_TEST_SOURCE_DIR) / "examples" / "general")) files.push_back(file);
+  for (const auto& file : json_files(fs::path(TSI_TEST_SOURCE_DIR) / "examples" / "pic"))
+    if (is_study(file)) files.push_back(file);
   for (const auto& file : files) {
     TempDir dir;
     const CommandResult r = run_tsi({"study", file.string(), "--out", dir / "out", "--no-plots", "--jobs", "2",
