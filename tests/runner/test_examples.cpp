@@ -59,7 +59,15 @@ TEST_CASE("examples: every study expands, and a bad path in one is caught") {
     if (is_study(file)) files.push_back(file);
   for (const auto& file : files) {
     TempDir dir;
-    const CommandResult r = run_tsi({"study", file.string(), "--out", dir / "out", "--no-plots", "--jobs", "2",
+    // A case that sets its own t_end (a slow reference run to a shorter time) loses it in a copy
+    // of the study, so that --set gives it 0 as the others (--set refuses a path a case sets).
+    std::string study = file.string();
+    Json spec = read_json(file);
+    bool rewritten = false;
+    for (Json& c : spec["cases"])
+      if (c.contains("set") && c["set"].contains("time.t_end")) c["set"].erase("time.t_end"), rewritten = true;
+    if (rewritten) study = write_config(dir, spec, file.filename().string());
+    const CommandResult r = run_tsi({"study", study, "--out", dir / "out", "--no-plots", "--jobs", "2",
                                      "--set", "time.t_end=0", "--set", "reference=null"});
     CAPTURE(file.filename().string());
     INFO(r.describe());
