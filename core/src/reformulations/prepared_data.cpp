@@ -84,9 +84,15 @@ Matrix PreparedData::r2(const Vector& w) {
 }
 
 Vector PreparedData::at(const Vector& v, double s) {
+  Vector out;
+  at(v, s, out);
+  return out;
+}
+
+void PreparedData::at(const Vector& v, double s, Vector& out) {
   order_reached_ = order_;  // the recursions lower it where they stop early
   phase_ = s;
-  if (method_ == DataMethod::automatic && order_ <= 2 && grid_.real_layout()) return low_order_data(v, s);
+  if (method_ == DataMethod::automatic && order_ <= 2 && grid_.real_layout()) return low_order_data(v, s, out);
   Matrix c;
   if (method_ == DataMethod::central)
     c = central_data(v, s, order_);
@@ -94,18 +100,18 @@ Vector PreparedData::at(const Vector& v, double s) {
     c = trajectory_data(v, s);
   else
     c = closed_data(v, s);
-  Vector out = Eigen::Map<const Vector>(c.data(), grid_.size());
-  return out;
+  out = Eigen::Map<const Vector>(c.data(), grid_.size());
 }
 
-Vector PreparedData::low_order_data(const Vector& v, double s) {
+void PreparedData::low_order_data(const Vector& v, double s, Vector& out) {
   // Order 2: U = v + eps (r1(v) - r1(v)(s)), r1 = A f_.(v), with f_tau of the constant grid v
-  // evaluated as the state's nonlinearity at the zero state shifted by v; order 1: U = v.
-  Vector out = Vector::Zero(grid_.size());
+  // evaluated as the state's nonlinearity at the zero state shifted by v (out is that zero
+  // state: the evaluation reads it into its grid before it writes); order 1: U = v.
+  out.resize(grid_.size());
+  out.setZero();
   Eigen::Map<Matrix> c(out.data(), dim_, columns_);
   if (order_ >= 2) {
-    const Vector zero = Vector::Zero(grid_.size());
-    grid_.nonlinear(zero, &v, out, s);
+    grid_.nonlinear(out, &v, out, s);
     for (int j = 0; j < columns_; ++j) {
       const Complex a = grid_.antiderivative(j);
       if (a == 0.0)
@@ -116,7 +122,6 @@ Vector PreparedData::low_order_data(const Vector& v, double s) {
     c.col(0) -= grid_.evaluate(c, s);
   }
   c.col(0) += v;
-  return out;
 }
 
 Matrix PreparedData::closed_data(const Vector& v, double s) {

@@ -32,6 +32,9 @@ class PreparedData {
 
   /// The data centred at the phase s, as a state of the grid's layout.
   Vector at(const Vector& v, double s);
+  /// The same in `out` (its storage reused where it has the state's size: a run re-prepared
+  /// every step allocates no state-sized buffer per step).
+  void at(const Vector& v, double s, Vector& out);
   /// The order the last preparation reached (the asymptotic recursion may stop early).
   int order_reached() const { return order_reached_; }
   /// The vectors of the state's size the preparation of this order and method holds at its
@@ -47,7 +50,7 @@ class PreparedData {
   /// Orders 1 and 2 of the closed formulas in the real layout, directly as a state: the
   /// field on the real tau grid, no all-mode temporaries (a particle-in-cell state re-prepared
   /// every step is 10^8 coefficients).
-  Vector low_order_data(const Vector& v, double s);
+  void low_order_data(const Vector& v, double s, Vector& out);
   /// The closed formulas of SPEC.md (orders 1-3), as coefficients.
   Matrix closed_data(const Vector& v, double s);
   /// The derivative-free recursion (SPEC.md, "Higher order") to `order` with central

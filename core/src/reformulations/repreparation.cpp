@@ -13,7 +13,8 @@ bool Repreparer::after_step(long n, double t, Vector& y) {
     return false;
   const double s = fast_phase(t, eps_);
   const Vector v = grid_.evaluate(Eigen::Map<const Matrix>(y.data(), grid_.dim(), grid_.columns()), s);
-  Vector prepared = data_.at(v, s);
+  Vector& prepared = prepared_;  // the buffer of the state re-prepared before (swapped out below)
+  data_.at(v, s, prepared);
   if (rule_.mode == Repreparation::Mode::Auto) {
     // U is due when it has drifted off the prepared data through its own diagonal value by more
     // than a fraction of that data's tau variation (column 0 of the coefficients is the mean).
