@@ -111,8 +111,8 @@ void register_core(Registry& registry) {
                                              : method == "central" ? TwoScale::DataMethod::central
                                                                    : TwoScale::DataMethod::automatic;
     const bool real_layout = !p.has("real_layout") || p.boolean("real_layout");
-    auto made = std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation, data_method,
-                                                real_layout, p.context());
+    auto made = std::make_unique<TwoScale>(std::move(model), n_tau, order, repreparation, data_method, real_layout,
+                                           p.context());
     if (p.has("nyquist") && p.string("nyquist") == "average") made->average_nyquist();
     return made;
   };

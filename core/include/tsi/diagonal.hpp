@@ -42,8 +42,6 @@ class Diagonal {
     d.pairs_ = std::move(pairs);
     return d;
   }
-  /// Per stored value, the conjugate pair's imaginary part (0: none; empty: no pairs).
-  const RealVector& pairs() const { return pairs_; }
   /// f at stored value b (averaged over its pair where it has one), of the operator scaled by `scale`.
   template <class F>
   auto function_at(Index b, double scale, F&& f) const {

@@ -89,17 +89,18 @@ bool TauGrid::real_layout_for(const Model& model) {
   return !model.is_complex() && !model.has_linear_remainder();
 }
 
-void TauGrid::set_diagonal(const Vector& diagonal) {
-  grid_field_->set_diagonal(diagonal);
-  for (auto& field : column_fields_) field->set_diagonal(diagonal);
+void TauGrid::set_diagonal(Vector diagonal) {
+  diagonal_ = std::move(diagonal);
+  grid_field_->set_diagonal(diagonal_);
+  for (auto& field : column_fields_) field->set_diagonal(diagonal_);
 }
 
 void TauGrid::nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, double phase) {
   ++*evaluations_;
   if (needs_diagonal_) {
-    diagonal_ = evaluate(Eigen::Map<const Matrix>(y.data(), dim_, columns_), phase);
-    if (mean_shift) diagonal_ += *mean_shift;
-    set_diagonal(diagonal_);
+    Vector diagonal = evaluate(Eigen::Map<const Matrix>(y.data(), dim_, columns_), phase);
+    if (mean_shift) diagonal += *mean_shift;
+    set_diagonal(std::move(diagonal));
   }
   if (real_layout_) return nonlinear_real(y, mean_shift, out);
   if (threads_ > 1) return nonlinear_threaded(y, mean_shift, out);
@@ -247,10 +248,7 @@ double TauGrid::coefficient_norm(const Vector& y, bool without_mean) const {
 
 Matrix TauGrid::f_coefficients(Matrix w) {
   ++*evaluations_;
-  if (needs_diagonal_) {
-    diagonal_ = w.col(0);
-    set_diagonal(diagonal_);
-  }
+  if (needs_diagonal_) set_diagonal(w.col(0));
   if (grid_field_->in_place()) {
     grid_field_->evaluate(w, w);
     return to_coefficients(std::move(w));
@@ -263,10 +261,7 @@ Matrix TauGrid::f_coefficients(Matrix w) {
 
 Matrix TauGrid::df_coefficients(Matrix w, Matrix z) {
   ++*evaluations_;
-  if (needs_diagonal_) {
-    diagonal_ = w.col(0);
-    set_diagonal(diagonal_);
-  }
+  if (needs_diagonal_) set_diagonal(w.col(0));
   model_->linear_flow(taus_, w);
   model_->linear_flow(taus_, z);
   Matrix df(dim_, n_tau_);

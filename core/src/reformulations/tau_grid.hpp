@@ -77,8 +77,8 @@ class TauGrid {
   /// nonlinear on the tau grid split over threads_: each thread transforms its rows and
   /// evaluates the field on its columns (between barriers); the same numbers as the serial path.
   void nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out);
-  /// Hands the diagonal value to every binding (fields that read it only).
-  void set_diagonal(const Vector& diagonal);
+  /// Keeps the diagonal value and hands it to every binding (fields that read it only).
+  void set_diagonal(Vector diagonal);
   /// A field evaluation on threads_ threads: transform_in(p) and transform_out(p) on part p's
   /// rows, evaluate(p, c0, cn) on its columns [c0, c0 + cn), with barriers between; an
   /// exception from evaluate reaches the caller once every thread has finished.
@@ -98,7 +98,7 @@ class TauGrid {
   std::vector<Index> column_begin_;  // threads_ + 1 boundaries of the threads' tau columns
   std::vector<std::unique_ptr<TauGridField>> column_fields_;  // f_tau on each thread's columns
   bool needs_diagonal_ = false;  // the bindings read U on the diagonal
-  Vector diagonal_;
+  Vector diagonal_;  // the bindings' diagonal value, alive while they evaluate
   // Complex layout:
   std::unique_ptr<FftBatch> fft_;  // the tau transforms, both ways, in threads_ parts (from and to the caller's memory)
   Matrix field_;   // the field on the grid where the model does not evaluate in place (first use)

@@ -199,16 +199,24 @@ void Field::pad_field() {
 }
 
 void Field::solve(const double* base, ParticleLayout layout) {
+  if (same_positions(base, layout)) return;
   deposit(base, layout);
   poisson();
-  at_valid_ = false;
+  const Index ps = layout.particle_stride, cs = layout.component_stride;
+  x_solved_.resize(2 * g_.particles);
+  for (Index k = 0; k < g_.particles; ++k) {
+    x_solved_(2 * k) = base[k * ps];
+    x_solved_(2 * k + 1) = base[k * ps + cs];
+  }
+  solved_ = true;
+  e_at_solved_ = false;
 }
 
 bool Field::same_positions(const double* base, ParticleLayout layout) const {
-  if (!at_valid_) return false;
+  if (!solved_) return false;
   const Index ps = layout.particle_stride, cs = layout.component_stride;
   for (Index k = 0; k < g_.particles; ++k)
-    if (base[k * ps] != x_at_(2 * k) || base[k * ps + cs] != x_at_(2 * k + 1)) return false;
+    if (base[k * ps] != x_solved_(2 * k) || base[k * ps + cs] != x_solved_(2 * k + 1)) return false;
   return true;
 }
 
@@ -221,21 +229,16 @@ const double* Field::interpolate(const double* base, ParticleLayout layout) {
   else
     interpolate_all<6>(base, layout, g_.particles, inverse_dx_, inverse_dy_, g_.n_x, g_.n_y, padded_x_,
                        padded_e_.data(), e_at_.data());
-  at_valid_ = false;  // E of another set of positions' field
+  e_at_solved_ = false;  // E at other positions than the field's own (the diagonal field)
   return e_at_.data();
 }
 
 const double* Field::at_particles(const double* base, ParticleLayout layout) {
-  if (same_positions(base, layout)) return e_at_.data();
   solve(base, layout);
-  interpolate(base, layout);
-  x_at_.resize(2 * g_.particles);
-  const Index ps = layout.particle_stride, cs = layout.component_stride;
-  for (Index k = 0; k < g_.particles; ++k) {
-    x_at_(2 * k) = base[k * ps];
-    x_at_(2 * k + 1) = base[k * ps + cs];
+  if (!e_at_solved_) {
+    interpolate(base, layout);
+    e_at_solved_ = true;
   }
-  at_valid_ = true;
   return e_at_.data();
 }
 

@@ -4,7 +4,6 @@
 // [0, 2 pi / k_y), -lap phi = rho - mean(rho) solved by FFT, and E = -grad phi interpolated
 // back at the particles with the deposition's own shape function (so that the self-force sums
 // to zero and the total momentum turns with the magnetic field).
-#include <array>
 #include <memory>
 
 #include "tsi/spectral_grid.hpp"
@@ -50,11 +49,12 @@ class Field {
   Field(const Field&) = delete;
   Field& operator=(const Field&) = delete;
 
-  /// rho deposited from the positions of the N particles at `base` (layout), then E.
+  /// rho deposited from the positions of the N particles at `base` (layout), then E; nothing
+  /// to do for the positions of the last solve (the columns of the constant grid order-2 data
+  /// evaluate, or W, Q and W_E of one state, share one solve).
   void solve(const double* base, ParticleLayout layout);
   /// E at each of the N particles at `base`: (E1, E2) of particle k at 2k, 2k + 1, from the
-  /// field of these same positions. Positions equal to the last call's reuse its values (the
-  /// columns of prepared data of order 1 share theirs).
+  /// field of these same positions (computed once for the positions of the last solve).
   const double* at_particles(const double* base, ParticleLayout layout);
   /// E of the last solve at each of the N particles at `base` (as at_particles' values).
   const double* interpolate(const double* base, ParticleLayout layout);
@@ -79,8 +79,10 @@ class Field {
   RealVector padded_e_;    // the same points, (E1, E2) pairs
   bool padded_current_ = false;                    // padded E is the last solve's
   RealVector k1_, k2_, inverse_k2_;  // per point of the half spectrum
-  RealVector e_at_, x_at_;           // at_particles: E and the positions it was computed at
-  bool at_valid_ = false;
+  RealVector x_solved_;  // the positions of the last solve
+  bool solved_ = false;
+  RealVector e_at_;           // E at the particles of the last interpolation
+  bool e_at_solved_ = false;  // ... and those are the positions of the last solve
   double charge_ = 0.0;
 };
 

@@ -82,8 +82,7 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
     const std::lock_guard<std::mutex> lock(mutex_);
     Field& field = shared_field();
     // f = f_0 = (v, E(x)): the filtered column at tau = 0, where R(0) = I.
-    for (Index j = 0; j < u.cols(); ++j)
-    {
+    for (Index j = 0; j < u.cols(); ++j) {
       const double* column = reinterpret_cast<const double*>(u.col(j).data());
       filtered_column(field.at_particles(column, complex_layout), g_.particles, column, complex_layout, 1.0, 0.0,
                       [&](Index k, int c, double value) { out(4 * k + c, j) = value; });
@@ -156,8 +155,7 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   void filtered_field(const tsi::RealVector& taus, MatrixRef u, MatrixRef out) const override {
     const std::lock_guard<std::mutex> lock(mutex_);
     Field& field = shared_field();
-    for (Index j = 0; j < u.cols(); ++j)
-    {
+    for (Index j = 0; j < u.cols(); ++j) {
       const double* column = reinterpret_cast<const double*>(u.col(j).data());
       filtered_column(field.at_particles(column, complex_layout), g_.particles, column, complex_layout,
                       std::cos(taus(j)), std::sin(taus(j)), [&](Index k, int c, double value) { out(4 * k + c, j) = value; });
@@ -181,9 +179,7 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
         {"W", "total energy: sum w |v|^2 / 2 + (1/2) int |E|^2 (conserved by the flow, by PIC up to grid heating)",
          [this, kinetic](const Vector& u) {
            const std::lock_guard<std::mutex> lock(mutex_);
-           Field& field = shared_field();
-           field.solve(reinterpret_cast<const double*>(u.data()), complex_layout);
-           return kinetic(u) + field.field_energy();
+           return kinetic(u) + field_of(u).field_energy();
          }},
         {"P", "|total momentum| |sum w v| (P turns with the field: R(t/eps) P(0))",
          [g](const Vector& u) {
@@ -197,16 +193,12 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
         {"Q", "total charge int rho (|box|: the deposition loses nothing)",
          [this](const Vector& u) {
            const std::lock_guard<std::mutex> lock(mutex_);
-           Field& field = shared_field();
-           field.solve(reinterpret_cast<const double*>(u.data()), complex_layout);
-           return field.charge();
+           return field_of(u).charge();
          }},
         {"W_E", "electric energy (1/2) int |E|^2 (exchanged with the kinetic energy: Landau damping, instabilities)",
          [this](const Vector& u) {
            const std::lock_guard<std::mutex> lock(mutex_);
-           Field& field = shared_field();
-           field.solve(reinterpret_cast<const double*>(u.data()), complex_layout);
-           return field.field_energy();
+           return field_of(u).field_energy();
          },
          false}};
   }
@@ -217,6 +209,12 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   Field& shared_field() const {
     if (!field_) field_ = std::make_unique<Field>(g_);
     return *field_;
+  }
+  // The shared field solved for the positions of a model state (callers hold mutex_).
+  Field& field_of(const Vector& u) const {
+    Field& field = shared_field();
+    field.solve(reinterpret_cast<const double*>(u.data()), complex_layout);
+    return field;
   }
 
   Geometry g_;

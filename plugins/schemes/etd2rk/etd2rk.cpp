@@ -3,8 +3,10 @@
 //   U^* = e^z U^n + h phi1(z) N(t_n, U^n),
 //   U^{n+1} = U^* + h phi2(z) [N(t_n + h, U^*) - N(t_n, U^n)],        z = h L,
 // the linear part exactly, the forcing interpolated linearly over the step. One step: it
-// needs no history, so a re-prepared state goes on at once. Second order; with re-preparation
-// every step and data of order 1 it is UAPIC.jl's fortran/bupdate.F90 on a uniform field.
+// needs no history, so a re-prepared state goes on at once. Second order; re-prepared every step
+// with data of order 2 (the peer's "first-order corrected" data), on vlasov-poisson-2d's
+// diagonal field and with the Nyquist mode averaged, it is UAPIC.jl's fortran/bupdate.F90 on a
+// uniform field.
 #include <cmath>
 #include <memory>
 #include <variant>
