@@ -23,6 +23,7 @@
 #include "plugin_setup.hpp"
 #include "run.hpp"
 #include "run_files.hpp"
+#include "split_processes.hpp"
 #include "study_command.hpp"
 #include "study_distributed.hpp"
 #include "summary.hpp"
@@ -47,9 +48,15 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
   // own objects are checked (their memory first), still before anything is computed.
   tsi::app::check_run_steps(config, settings.max_steps);
   if (out_dir.empty()) out_dir = "out/" + std::filesystem::path(config_path).stem().string();
-  tsi::app::prepare_output_dir(out_dir);
+  const tsi::Collective* split = settings.context.collective;
+  const bool writer = !split || split->rank() == 0;  // a split run's files are rank 0's
+  if (split) {
+    tsi::app::agree_to_start(*split, config, registry, settings, [&] { if (writer) tsi::app::prepare_output_dir(out_dir); });
+  } else {
+    tsi::app::prepare_output_dir(out_dir);
+  }
 
-  const bool tty = isatty(fileno(stderr));
+  const bool tty = writer && isatty(fileno(stderr));
   auto phase_started = std::chrono::steady_clock::now();
   std::string phase;
   auto progress = [&](double fraction, const char* what) {
@@ -65,8 +72,10 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
     else
       fmt::print(stderr, "\r  {}: {:5.1f}%", what, 100.0 * fraction);
   };
-  const tsi::app::RunOutcome outcome = tsi::app::execute_run(config, registry, settings, progress, nullptr, out_dir);
+  const tsi::app::RunOutcome outcome =
+      tsi::app::execute_run(config, registry, settings, progress, nullptr, writer ? out_dir : std::string());
   if (tty) fmt::print(stderr, "\r{:80}\r", "");
+  if (!writer) return outcome.ok ? 0 : 1;  // the same status on every rank: its stops are agreed
   tsi::app::write_run_files(out_dir, outcome);  // IoError (exit 3) when result.json cannot be written
   fmt::print("{}", tsi::app::run_summary(outcome, out_dir));
   if (!outcome.io_error.empty()) {  // the run's own files are written as far as they could be
@@ -124,6 +133,10 @@ int main(int argc, char** argv) {
   const std::string max_steps_help =
       "refuse a run (or its reference) estimated to take more than N steps, before it starts (default 1e9)";
   run->add_option("--max-steps", max_steps, max_steps_help);
+  bool split = false;
+  run->add_flag("--split", split,
+                "split the run's state over MPI ranks: mpirun -np P tsi run CONFIG --split (vlasov-poisson-2d's "
+                "particles; one thread per rank unless --threads; rank 0 writes the files)");
 
   auto* study = app.add_subcommand("study", "run a study (a base config and lists of values) in parallel");
   std::string study_path, study_out;
@@ -174,12 +187,24 @@ int main(int argc, char** argv) {
   // Installed before anything is read, so that a signal at any moment of a run is kept.
   if (run->parsed() || study->parsed()) tsi::app::install_interrupt_handlers();
 
+  std::unique_ptr<tsi::Collective> processes;  // tsi run --split: MPI's ranks, finalised last
   try {
+    if (run->parsed() && split) {
+      processes = tsi::app::start_split_processes();
+    } else if (run->parsed() && tsi::app::launched_processes() > 1) {
+      if (tsi::app::launched_rank() != 0) throw tsi::app::ReportedElsewhere("launched without --split");
+      throw tsi::ConfigError("--split", fmt::format("tsi run was started on {} MPI processes without --split: each "
+                                                    "would run the whole run and write the same files; add --split "
+                                                    "to split one run over them, or use tsi study for many runs",
+                                                    tsi::app::launched_processes()));
+    }
     // The run's settings, built once from the flags and passed down (nothing process wide):
-    // a run's tau grid on every core unless --threads says otherwise, a study's runs on one each.
+    // a run's tau grid on every core unless --threads says otherwise, a study's runs on one
+    // each, a split run's ranks on one each (one rank per core).
     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    const tsi::app::RunSettings settings =
-        tsi::app::RunSettings::from_flags(threads > 0 ? threads : run->parsed() ? cores : 1, fft_threads, max_steps);
+    tsi::app::RunSettings settings = tsi::app::RunSettings::from_flags(
+        threads > 0 ? threads : run->parsed() && !processes ? cores : 1, fft_threads, max_steps);
+    settings.context.collective = processes.get();
     tsi::Registry registry;
     tsi::PluginLoader loader(registry);
     for (const auto& warning : tsi::app::load_plugins(loader, registry, plugin_files))
@@ -220,7 +245,8 @@ int main(int argc, char** argv) {
     spdlog::error("{}", e.what());
     return 3;
   } catch (const tsi::Error& e) {
-    spdlog::error("{}", e.what());
+    // A split run's ranks refuse a bad input alike (tsi::app::agree_to_start): said once.
+    if (!dynamic_cast<const tsi::app::ReportedElsewhere*>(&e)) spdlog::error("{}", e.what());
     return 2;
   } catch (const std::exception& e) {
     spdlog::error("unexpected: {}", e.what());

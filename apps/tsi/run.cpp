@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <exception>
 #include <filesystem>
 #include <limits>
 
@@ -15,6 +17,7 @@
 #include "interrupt.hpp"
 #include "run_recorder.hpp"
 #include "tsi/assembly.hpp"
+#include "tsi/collective.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/driver.hpp"
 #include "tsi/error.hpp"
@@ -342,6 +345,88 @@ Json richardson_estimate(const Json& config, const Registry& registry, const Run
 
 }  // namespace
 
+namespace {
+
+// Refuses (ConfigError naming the field) what a run split over processes cannot do: each
+// process must make the same reductions in the same order, so nothing may decide from its own
+// share alone (an adaptive step size: the norms of the fixed-point tests, the prepared data and
+// the re-preparation are the whole state's), and the states the runner interpolates are not
+// split.
+void check_split_run(const Json& config, const Assembly& assembly, const Registry& registry) {
+  const Model& model = *assembly.model;
+  if (!model.split_across_processes())
+    throw ConfigError("--split", fmt::format("the model \"{}\" does not split its state over processes; expected "
+                                             "a model that does (vlasov-poisson-2d: its particles)",
+                                             config["model"]["name"].get<std::string>()));
+  if (model.is_complex()) throw ConfigError("--split", "a complex state is not split over processes");
+  if (assembly.traits.adaptive)
+    throw ConfigError("scheme", fmt::format("\"{}\" chooses its steps from the state, which a split run holds in "
+                                            "shares; expected a scheme with fixed steps under --split",
+                                            assembly.scheme_entry->info.name));
+  if (config.contains("output") && config["output"].contains("times") && !config["output"]["times"].empty())
+    throw ConfigError("output.times", "dense output is not available under --split; expected no output.times");
+  if (config.contains("reference") && config["reference"]["scheme"] != exact_reference &&
+      registry.scheme(config["reference"]["scheme"], "reference.scheme").traits.adaptive)
+    throw ConfigError("reference.scheme", fmt::format("\"{}\" chooses its steps from the state, which a split run "
+                                                      "holds in shares; expected a reference with a fixed step "
+                                                      "(reference.h) under --split",
+                                                      config["reference"]["scheme"].get<std::string>()));
+}
+
+// A failure on one process of a split run: the others wait in a reduction and would never
+// learn of it. Rank 0 keeps what it has (the streamed rows, result.json saying "failed"), then
+// every process is stopped.
+[[noreturn]] void stop_split_run(const Collective& split, const std::string& stream_dir, const Json& result,
+                                 RunRecorder& recorder, const std::string& message, int code) {
+  fmt::print(stderr, "tsi: error: rank {} of {}: {}\n", split.rank(), split.size(), message);
+  if (!stream_dir.empty()) {
+    try {
+      recorder.flush_csv();
+      Json failed = result;
+      failed["status"] = "failed";
+      failed["message"] = fmt::format("rank {} of {}: {}; every rank was stopped; invariants.csv.partial holds the "
+                                      "rows up to step {}",
+                                      split.rank(), split.size(), message, recorder.steps());
+      failed["t_reached"] = recorder.t_reached();
+      failed["steps_done"] = recorder.steps();
+      write_file_atomically(stream_dir + "/result.json", failed.dump(2) + "\n");
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "tsi: error: {}\n", e.what());
+    }
+  }
+  split.abort(code);
+  std::abort();  // abort() does not return; a virtual call is not known to the compiler as noreturn
+}
+
+}  // namespace
+
+void agree_to_start(const Collective& split, const Json& config, const Registry& registry,
+                    const RunSettings& settings, const std::function<void()>& before) {
+  std::exception_ptr failure;
+  try {
+    before();
+    AssemblyOptions options;
+    options.context = settings.context;
+    const Assembly assembly = assemble(resolved_selection(config), registry, options);
+    check_split_run(config, assembly, registry);
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  double refused[2] = {failure ? 1.0 : 0.0, failure && split.rank() == 0 ? 1.0 : 0.0};  // anywhere, on rank 0
+  split.max(refused, 2);
+  if (refused[0] == 0.0) return;
+  if (failure && split.rank() != 0 && refused[1] != 0.0) {
+    try {
+      std::rethrow_exception(failure);
+    } catch (const std::exception& e) {
+      throw ReportedElsewhere(e.what());
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+  throw Error(fmt::format("rank {} of {}: another rank refused the run (its error is above)", split.rank(),
+                          split.size()));
+}
+
 RunOutcome execute_run(const Json& config, const Registry& registry, const RunSettings& settings,
                        const ProgressFn& progress, const ReferenceSolution* shared_reference,
                        const std::string& stream_dir) {
@@ -378,6 +463,8 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   Stepper* stepper = nullptr;  // bound once the data are prepared
 
   const auto& rconf = config["reformulation"];
+  const Collective* split = settings.context.collective;  // tsi run --split: this process's share
+  if (split) check_split_run(config, assembly, registry);
   if (rconf.contains("initial_data_order") &&
       rconf["initial_data_order"].get<int>() < assembly.traits.initial_data_order) {
     result["warnings"].push_back(fmt::format(
@@ -406,6 +493,11 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
     outcome.csv_file = stream_dir + "/invariants.csv.partial";
   }
   RunRecorder recorder(*model, *reformulation, u0, config, outcome.csv_file);
+  recorder.split_over(split);
+  // A state of the whole run: a split run's shares gathered on rank 0 (empty elsewhere).
+  const auto whole = [split](const Vector& local) -> Vector {
+    return split ? Vector(split->gather(local.real()).cast<Complex>()) : local;
+  };
   // u between the steps (output.times), from the scheme's states interpolated in t.
   std::unique_ptr<DenseOutput> dense;
   if (config.contains("output") && config["output"].contains("times") && config["output"]["times"].is_array() &&
@@ -458,25 +550,29 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
     integrate(*stepper, y, n_steps, [&](long n, double t, const Vector& state) {
       const bool go_on = recorder.observe(n, t, state);
       if (go_on && dense) dense->observe(n, state);  // a finite state only
-      if (go_on && interrupted()) {  // kept up to this step, and written as "interrupted"
+      // A split run stops where any of its processes saw the signal, all at the same step.
+      if (go_on && (split ? !split->all(!interrupted()) : interrupted())) {  // kept up to this step, as "interrupted"
         status = "interrupted";
-        outcome.message = fmt::format("interrupted by signal {} at t = {:.6g} (step {} of {})", interrupt_signal(),
-                                      t, n, n_steps);
+        outcome.message = fmt::format("interrupted by signal {} at t = {:.6g} (step {} of {})",
+                                      interrupted() ? interrupt_signal() : 0, t, n, n_steps);
         return false;
       }
       if (progress && seconds_since(last_progress) > 0.5) {
         progress(static_cast<double>(n) / static_cast<double>(std::max(1L, n_steps)), "run");
         last_progress = Clock::now();
       }
-      if (go_on && state_every > 0 && !stream_dir.empty() && (n % state_every == 0 || n == n_steps)) {
+      if (go_on && state_every > 0 && (split || !stream_dir.empty()) && (n % state_every == 0 || n == n_steps)) {
         // The state as a file a run can start from (written to a temporary file, then renamed),
         // and result.json's checkpoint says at which time it is.
-        const Vector x = model->to_physical(reformulation->read_back(state, t));
-        std::vector<std::uint64_t> shape;
-        for (const Index d : model->physical_shape()) shape.push_back(static_cast<std::uint64_t>(d));
-        write_npy(stream_dir + "/state.npy", x, model->is_complex(), shape);
-        result["state"] = {{"file", "state.npy"}, {"t", t}, {"step", n}};
-        checkpoint(n, t);
+        Vector x = whole(model->to_physical(reformulation->read_back(state, t)));
+        if (!stream_dir.empty()) {
+          model->canonicalize_physical(x);
+          std::vector<std::uint64_t> shape;
+          for (const Index d : model->physical_shape()) shape.push_back(static_cast<std::uint64_t>(d));
+          write_npy(stream_dir + "/state.npy", x, model->is_complex(), shape);
+          result["state"] = {{"file", "state.npy"}, {"t", t}, {"step", n}};
+          checkpoint(n, t);
+        }
       }
       if (go_on && !stream_dir.empty() && seconds_since(last_checkpoint) > checkpoint_seconds) checkpoint(n, t);
       return go_on;
@@ -488,10 +584,12 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   } catch (const IoError& e) {  // the output failed (a full disk), not the computation
     status = "failed";
     outcome.io_error = e.what();
+    if (split) stop_split_run(*split, stream_dir, result, recorder, e.what(), 3);
   } catch (const std::exception& e) {
     status = "failed";
     outcome.message = fmt::format("at t = {:.6g} (step {}): {}", step_time(recorder.steps(), h),
                                   recorder.steps() + 1, e.what());
+    if (split) stop_split_run(*split, stream_dir, result, recorder, outcome.message, 1);
   }
   if (outcome.io_error.empty()) {
     try {
@@ -515,7 +613,11 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   outcome.csv = recorder.csv();
   result["status"] = status;
   if (!outcome.ok) result["message"] = outcome.message;
-  const Vector x = model->to_physical(recorder.u_last());
+  // The final state: this process's share (errors are norms over every process) and the whole
+  // run's for the files (gathered on rank 0 of a split run).
+  const Vector x_here = model->to_physical(recorder.u_last());
+  const Vector x = whole(x_here);
+  if (split) result["split"] = {{"processes", split->size()}, {"memory", "rank 0's"}};
   if (dense) {
     dense->finish();
     outcome.output_times = dense->times();
@@ -585,20 +687,20 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
       result["message"] = outcome.message;
       return outcome;
     }
-    Json error = {{"relative", model->error_norm(x - ref.x) / model->error_norm(ref.x)},
-                  {"absolute", model->error_norm(x - ref.x)},
+    Json error = {{"relative", model->error_norm(x_here - ref.x) / model->error_norm(ref.x)},
+                  {"absolute", model->error_norm(x_here - ref.x)},
                   {"reference", ref.settings}};
     error["reference"]["wall_seconds"] = ref.wall_seconds;
     error["reference"]["estimated_relative_accuracy"] =
         std::isfinite(ref.accuracy) ? Json(ref.accuracy) : Json(nullptr);
-    outcome.reference_u_final = ref.x;
+    outcome.reference_u_final = whole(ref.x);
     error["reference"]["u_final"] = state_entry(ref.x, outcome.complex_state, outcome.state_shape, reference_u_final_file);
     result["error"] = error;
   }
   if (outcome.ok && config.contains("output") &&
       config["output"].value("error_estimate", std::string("none")) == "richardson") {
     result["error_estimate"] =
-        richardson_estimate(config, registry, settings, assembly.traits, *model, x, n_steps, progress);
+        richardson_estimate(config, registry, settings, assembly.traits, *model, x_here, n_steps, progress);
     if (result["error_estimate"]["status"] == "interrupted") {  // the run's results are kept, as for a reference
       outcome.ok = false;
       result["status"] = "interrupted";

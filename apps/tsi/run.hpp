@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "tsi/collective.hpp"
+#include "tsi/error.hpp"
 #include "tsi/params.hpp"
 #include "tsi/registry.hpp"
 
@@ -62,6 +64,20 @@ struct RunSettings {
   /// (threads below 1; a step limit outside 1 .. 1e12).
   static RunSettings from_flags(int tau_grid_threads, int fft_threads, double max_steps);
 };
+
+/// An error another process of a split run has already reported (its exit code is 2; it is
+/// not printed again).
+struct ReportedElsewhere : Error {
+  using Error::Error;
+};
+
+/// A split run's processes start together or not at all: each runs `before` (rank 0 prepares
+/// the output directory) and builds the run's objects (the model takes its share, and what a
+/// split run cannot do is refused), then all learn whether every one could. A process's own
+/// refusal is rethrown on it (on ranks other than 0 as ReportedElsewhere when rank 0 refused
+/// too: said once); where only others refused, an Error says so.
+void agree_to_start(const Collective& split, const Json& resolved, const Registry& registry,
+                    const RunSettings& settings, const std::function<void()>& before);
 
 /// Refuses (ConfigError naming time.h) a run whose t_end / h exceeds max_steps, with the
 /// estimate and how to lift the limit; computed in double, before anything is narrowed.

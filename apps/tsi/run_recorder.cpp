@@ -147,11 +147,13 @@ double RunRecorder::drift(int k) const {
                                       : std::numeric_limits<double>::quiet_NaN();
 }
 
+bool RunRecorder::everywhere(bool flag) const { return collective_ ? collective_->all(flag) : flag; }
+
 bool RunRecorder::observe(long n, double t, const Vector& y) {
   // Between the recorded steps (every output.every-th and the last) only the cheap check: the
   // problem state is finite. One pass over it, no read-back and no allocation.
   if (n % every_ != 0 && n != n_steps_) {
-    if (algebra::all_finite(y)) return true;
+    if (everywhere(algebra::all_finite(y))) return true;
     status_ = "blow-up";
     message_ = fmt::format("the solution became non-finite at t = {:.6g} (step {}); the last recorded state is "
                            "from t = {:.6g} (step {}, output.every = {})",
@@ -161,7 +163,7 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
   const Vector u = reformulation_.read_back(y, t);
   double values[3] = {0.0, 0.0, 0.0};
   if (hamiltonian_) values[0] = model_.energy(u), values[1] = model_.oscillatory_energy(u), values[2] = model_.mass(u);
-  if (!u.allFinite() || !std::isfinite(values[0] + values[1] + values[2])) {
+  if (!everywhere(u.allFinite() && std::isfinite(values[0] + values[1] + values[2]))) {
     status_ = "blow-up";
     message_ = fmt::format("the solution became non-finite at t = {:.6g} (step {})", t, n);
     return false;

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "tsi/collective.hpp"
 #include "tsi/params.hpp"
 #include "tsi/reformulation.hpp"
 
@@ -33,6 +34,10 @@ class RunRecorder {
   ~RunRecorder();
   RunRecorder(const RunRecorder&) = delete;
   RunRecorder& operator=(const RunRecorder&) = delete;
+
+  /// A run split over processes: its stops (a non-finite state anywhere) are decided over all
+  /// of them, so that every process stops at the same step.
+  void split_over(const Collective* collective) { collective_ = collective; }
 
   /// Writes the rows not yet on disk and closes the file (IoError when that fails).
   void finish_csv();
@@ -65,6 +70,8 @@ class RunRecorder {
   double drift(int k) const;
 
  private:
+  // A flag of this process, over every process of a split run.
+  bool everywhere(bool flag) const;
   struct Track {
     double initial = 0.0, final = 0.0, max_rel_error = 0.0;
   };
@@ -78,6 +85,7 @@ class RunRecorder {
     double min = 0.0, max = 0.0;  // a diagnostic's range (conserved = false)
   };
   const Model& model_;
+  const Collective* collective_ = nullptr;
   Reformulation& reformulation_;
   bool hamiltonian_;  // H, I, m and their columns only where the model declares the structure
   long every_, n_steps_;

@@ -23,7 +23,7 @@ int AndersonSolver::iterate(Vector& x, FixedPointMap g, double& increment) {
   for (int k = 1; k <= options().max_iter; ++k) {
     g(x, gx_);
     algebra::axpby(1.0, gx_, -1.0, x, residual_);
-    increment = algebra::relative_increment(gx_, x);
+    increment = this->increment(gx_, x);
     if (increment <= options().tol) {
       algebra::copy(gx_, x);
       return k;
@@ -47,6 +47,10 @@ int AndersonSolver::iterate(Vector& x, FixedPointMap g, double& increment) {
     for (int i = 0; i < stored; ++i) {
       rhs(i) = algebra::inner(residual_diffs_[i], residual_);
       for (int j = 0; j <= i; ++j) gram(i, j) = gram(j, i) = algebra::inner(residual_diffs_[i], residual_diffs_[j]);
+    }
+    if (options().collective) {  // the inner products of the whole split state
+      options().collective->sum(rhs.data(), stored);
+      options().collective->sum(gram.data(), static_cast<Index>(stored) * stored);
     }
     gram.diagonal().array() += 1e-13 * gram.diagonal().maxCoeff();
     const SmallVector gamma = gram.ldlt().solve(rhs);

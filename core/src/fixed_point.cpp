@@ -6,6 +6,7 @@
 
 #include "anderson.hpp"
 #include "picard.hpp"
+#include "tsi/algebra.hpp"
 #include "tsi/error.hpp"
 
 namespace tsi {
@@ -37,6 +38,7 @@ FixedPointOptions fixed_point_options(const Params& params) {
   o.anderson_depth = static_cast<int>(params.integer("anderson_depth"));
   o.on_failure = params.string("on_failure");
   o.guess = params.string("guess");
+  o.collective = params.context().collective;
   return o;
 }
 
@@ -44,6 +46,13 @@ FixedPointSolver::FixedPointSolver(FixedPointOptions options) : options_(std::mo
   // Grown to the largest count seen, not sized by max_iter (up to 1e6: 8 MB per solver for a
   // histogram whose counts sit below a few dozen).
   stats_.sweeps_histogram.assign(static_cast<size_t>(std::min(options_.max_iter, 64)) + 1, 0);
+}
+
+double FixedPointSolver::increment(const Vector& next, const Vector& x) const {
+  double m[2];
+  algebra::increment_maxima(next, x, m);
+  if (options_.collective) options_.collective->max(m, 2);
+  return algebra::relative_increment(m);
 }
 
 bool FixedPointSolver::solve(Vector& x, FixedPointMap g) {

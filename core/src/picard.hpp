@@ -15,7 +15,7 @@ class PicardSolver final : public FixedPointSolver {
     next_.resize(x.size());
     for (int k = 1; k <= options().max_iter; ++k) {
       g(x, next_);
-      increment = algebra::relative_increment(next_, x);
+      increment = this->increment(next_, x);
       algebra::swap(x, next_);
       if (increment <= options().tol) return k;
     }

@@ -198,11 +198,10 @@ using tsi::inner;
 /// max_i |x_i| (types.hpp's, which also takes expressions).
 using tsi::max_norm;
 
-/// max_i |next_i - x_i| / max_i |next_i| (the denominator 1 when next is 0): the fixed-point
-/// solvers' convergence test. One pass over the doubles in two independent lanes, so the
-/// maxima stay in vector registers (std::max over complex norms in one chain ran at the
-/// latency of a compare: 30% of a charged-particle step).
-inline double relative_increment(const Vector& next, const Vector& x) {
+/// The squares of max_i |next_i - x_i| and of max_i |next_i| into m[0] and m[1]: one pass over
+/// the doubles in two independent lanes, so the maxima stay in vector registers (std::max over
+/// complex norms in one chain ran at the latency of a compare: 30% of a charged-particle step).
+inline void increment_maxima(const Vector& next, const Vector& x, double m[2]) {
   const double* pa = reinterpret_cast<const double*>(next.data());
   const double* pb = reinterpret_cast<const double*>(x.data());
   const Index n = 2 * next.size();
@@ -222,8 +221,22 @@ inline double relative_increment(const Vector& next, const Vector& x) {
     d[0] = std::max(d[0], dr * dr + di * di);
     s[0] = std::max(s[0], pa[i] * pa[i] + pa[i + 1] * pa[i + 1]);
   }
-  const double scale = std::sqrt(std::max(s[0], s[1]));
-  return std::sqrt(std::max(d[0], d[1])) / (scale > 0.0 ? scale : 1.0);
+  m[0] = std::max(d[0], d[1]);
+  m[1] = std::max(s[0], s[1]);
+}
+
+/// The relative increment from increment_maxima's squares (the denominator 1 when next is 0).
+inline double relative_increment(const double m[2]) {
+  const double scale = std::sqrt(m[1]);
+  return std::sqrt(m[0]) / (scale > 0.0 ? scale : 1.0);
+}
+
+/// max_i |next_i - x_i| / max_i |next_i| (the denominator 1 when next is 0): the fixed-point
+/// solvers' convergence test.
+inline double relative_increment(const Vector& next, const Vector& x) {
+  double m[2];
+  increment_maxima(next, x, m);
+  return relative_increment(m);
 }
 
 }  // namespace tsi::algebra

@@ -4,6 +4,8 @@
 
 namespace tsi {
 
+class Collective;
+
 /// Threads one piece of work may use, and the size from which it uses them.
 struct TSI_API ThreadLimit {
   int threads = 1;
@@ -24,6 +26,9 @@ struct TSI_API Context {
   ThreadLimit tau_grid{1, 4096};
   /// FFTW's own threads inside each transform of at least 65536 values (tsi --fft-threads).
   ThreadLimit fft{1, 65536};
+  /// The processes the run's state is split over (tsi run --split under mpirun; collective.hpp),
+  /// or null: the whole state in this process. Owned by the runner, alive for the whole run.
+  const Collective* collective = nullptr;
 
   /// The context of the runner's flags: a ConfigError naming --threads or --fft-threads for
   /// a count below 1.

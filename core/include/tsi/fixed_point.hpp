@@ -2,6 +2,7 @@
 #include <memory>
 #include <string>
 
+#include "tsi/collective.hpp"
 #include "tsi/export.hpp"
 #include "tsi/function_ref.hpp"
 #include "tsi/params.hpp"
@@ -18,6 +19,9 @@ struct TSI_API FixedPointOptions {
   int anderson_depth = 3;          ///< Anderson: how many previous residuals to mix
   std::string on_failure = "warn"; ///< "warn": count and continue; "stop": throw tsi::Error
   std::string guess = "previous";  ///< starting guess of the scheme: "previous" step's stage, or "linear" part only
+  /// The processes a split state lies on (Params' context): the convergence test and Anderson's
+  /// inner products are taken over all of them, so every process sweeps as often. Null: one.
+  const Collective* collective = nullptr;
 };
 
 /// The parameters every implicit scheme takes for its fixed-point iteration.
@@ -49,6 +53,8 @@ class TSI_API FixedPointSolver {
  protected:
   /// One solve: returns the number of sweeps, or -1 when max_iter did not reach tol.
   virtual int iterate(Vector& x, FixedPointMap g, double& increment) = 0;
+  /// The relative increment from x to next, over every process of a split state.
+  double increment(const Vector& next, const Vector& x) const;
 
  private:
   FixedPointOptions options_;

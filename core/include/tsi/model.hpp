@@ -68,6 +68,14 @@ class TSI_API Model {
   virtual double max_linear_frequency() const { return 1.0; }
   /// The model's own invariants beyond H, I and m (none by default).
   virtual std::vector<ModelInvariant> invariants() const { return {}; }
+  /// True when the model holds only this process's share of the state of a run split over
+  /// processes (Params' context has a Collective): its field, invariants and error norm reduce
+  /// over the processes, and physical_shape() is the whole state's. vlasov-poisson-2d's
+  /// particles; no other model splits (the runner refuses to split them).
+  virtual bool split_across_processes() const { return false; }
+  /// Physical variables as a state file keeps them for a run to start from (state.npy): a
+  /// periodic model's positions brought into its box. Unchanged by default.
+  virtual void canonicalize_physical(Vector& /*x*/) const {}
 
   // ---- Declared capabilities (model_capabilities.hpp): null where the model has none -----
 

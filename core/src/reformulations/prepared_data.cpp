@@ -161,8 +161,8 @@ Matrix PreparedData::central_data(const Vector& v, double s, int order) {
     const Vector next_u = v - grid_.evaluate(next, s);
     Matrix candidate = next;
     candidate.col(0) += next_u;
-    const double correction = (candidate - data).norm();
-    if (!keeps_decreasing(k, correction, last_correction, data.norm())) break;
+    const double correction = grid_.norm_from_squares((candidate - data).squaredNorm());
+    if (!keeps_decreasing(k, correction, last_correction, grid_.norm_from_squares(data.squaredNorm()))) break;
     last_correction = correction;
     data.swap(candidate);
     u = next_u;
@@ -223,7 +223,7 @@ Matrix PreparedData::trajectory_data(const Vector& v, double s) {
   Vector drift = f.col(0);
   f.resize(0, 0);
   if (remainder) drift += remainder_.cwiseProduct(v);
-  const double speed = drift.norm() / v.norm();
+  const double speed = grid_.norm_from_squares(drift.squaredNorm()) / grid_.norm_from_squares(v.squaredNorm());
   const double length = trajectory_length(static_cast<int>(nodes.x.size()), remainder);
   const double h = speed > 0.0 && std::isfinite(speed) ? length / speed : length;
   const int m = static_cast<int>(nodes.x.size()), c = nodes.center;
@@ -242,8 +242,8 @@ Matrix PreparedData::trajectory_data(const Vector& v, double s) {
     trajectory_level(points, previous, nodes, h, next, drifts, k == order_ ? c : -1);
     Matrix candidate = grid_.all_modes(Eigen::Map<const Matrix>(next[c].data(), dim_, columns_));
     candidate.col(0) += v - grid_.evaluate(candidate, s);  // U(s) = v exactly
-    const double correction = (candidate - data).norm();
-    if (!keeps_decreasing(k, correction, last_correction, data.norm())) break;
+    const double correction = grid_.norm_from_squares((candidate - data).squaredNorm());
+    if (!keeps_decreasing(k, correction, last_correction, grid_.norm_from_squares(data.squaredNorm()))) break;
     last_correction = correction;
     data.swap(candidate);
     order_reached_ = k;
@@ -262,7 +262,8 @@ std::optional<std::vector<Vector>> PreparedData::averaged_trajectory(const Vecto
   std::vector<Vector> points = picard_step(v, std::vector<Vector>(m, drift), nodes, h);
   std::vector<Vector> phi(m, Vector::Zero(grid_.size())), next(m, Vector(grid_.size())), drifts(m);
   const double target =
-      std::max(64.0 * std::numeric_limits<double>::epsilon(), 1e-3 * std::pow(eps_, order_)) * v.norm();
+      std::max(64.0 * std::numeric_limits<double>::epsilon(), 1e-3 * std::pow(eps_, order_)) *
+      grid_.norm_from_squares(v.squaredNorm());
   // The sweeps gain about a factor eps each; where they gain less (Klein-Gordon at eps = 1e-2:
   // 5-10x) the data's own truncation is as slow, and a few sweeps more suffice.
   const int max_sweeps = order_ + 4;
@@ -275,12 +276,12 @@ std::optional<std::vector<Vector>> PreparedData::averaged_trajectory(const Vecto
     double change = 0.0, moved = 0.0;
     for (int i = 0; i < m; ++i) {
       change = std::max(change, grid_.coefficient_norm(next[i] - phi[i]));
-      moved = std::max(moved, (next_points[i] - points[i]).norm());
+      moved = std::max(moved, grid_.norm_from_squares((next_points[i] - points[i]).squaredNorm()));
     }
     // Near eps = 1 the sweeps can diverge with the asymptotic series: no trajectory then.
     if (sweep > 2 && !(change < 2.0 * last_change)) return std::nullopt;
     last_change = change;
-    const double error = eps_ * (next_u - u).norm() + eps_ * eps_ * moved;
+    const double error = eps_ * grid_.norm_from_squares((next_u - u).squaredNorm()) + eps_ * eps_ * moved;
     phi.swap(next);
     points.swap(next_points);
     u = next_u;

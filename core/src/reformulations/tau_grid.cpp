@@ -1,5 +1,7 @@
 #include "tau_grid.hpp"
 
+#include "tsi/collective.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -54,7 +56,8 @@ TauGrid::TauGrid(std::shared_ptr<const Model> model, int n_tau, bool real_layout
       evaluations_(&evaluations),
       taus_(n_tau),
       wave_numbers_(n_tau),
-      threads_(grid_threads(*model_, n_tau, context)) {
+      threads_(grid_threads(*model_, n_tau, context)),
+      collective_(context.collective) {
   for (int j = 0; j < n_tau; ++j) {
     taus_(j) = two_pi * j / n_tau;
     wave_numbers_(j) = j <= n_tau / 2 ? j : j - n_tau;
@@ -243,7 +246,12 @@ double TauGrid::coefficient_norm(const Vector& y, bool without_mean) const {
   double sum = 0.0;
   for (int j = without_mean ? 1 : 0; j < columns_; ++j)
     sum += (real_layout_ && j > 0 && 2 * j < n_tau_ ? 2.0 : 1.0) * c.col(j).squaredNorm();
-  return std::sqrt(sum);
+  return norm_from_squares(sum);
+}
+
+double TauGrid::norm_from_squares(double squares) const {
+  if (collective_) collective_->sum(&squares, 1);
+  return std::sqrt(squares);
 }
 
 Matrix TauGrid::f_coefficients(Matrix w) {

@@ -60,6 +60,9 @@ class TauGrid {
   Matrix all_modes(ConstMatrixRef stored) const;
   /// The norm of the coefficients of a state as if all N_tau modes were stored.
   double coefficient_norm(const Vector& y, bool without_mean = false) const;
+  /// sqrt(squares) over every process of a split run (Context::collective): the 2-norm of a
+  /// state, or of tau data, from the sum of its squares on this process's rows.
+  double norm_from_squares(double squares) const;
   /// The trigonometric interpolant of coefficients c at tau (Nyquist split half/half); c holds
   /// all N_tau modes or the real layout's N_tau/2 + 1.
   Vector evaluate(ConstMatrixRef c, double tau) const;
@@ -95,6 +98,7 @@ class TauGrid {
   RealVector wave_numbers_;
   std::unique_ptr<TauGridField> grid_field_;  // f_tau on taus_, bound once
   int threads_;
+  const Collective* collective_;  // the processes of a split run, or null
   std::vector<Index> column_begin_;  // threads_ + 1 boundaries of the threads' tau columns
   std::vector<std::unique_ptr<TauGridField>> column_fields_;  // f_tau on each thread's columns
   bool needs_diagonal_ = false;  // the bindings read U on the diagonal

@@ -94,6 +94,9 @@ double TwoScale::tau_roughness(const Vector& y) const {
     total += e;
     if (8.0 * std::abs(grid_.wave_numbers()(j)) > 3.0 * n_tau) top += e;  // |k| > 3/8 n: top quarter
   }
+  // Over every process of a split run (each sum a square of its norm).
+  total = std::pow(grid_.norm_from_squares(total), 2);
+  top = std::pow(grid_.norm_from_squares(top), 2);
   return total > 0.0 ? top / total : 0.0;
 }
 

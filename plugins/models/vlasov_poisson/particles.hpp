@@ -28,8 +28,8 @@ RealVector read_particles(const std::string& file);
 /// Refuses (a tsi::ConfigError naming model.particles) particles whose positions are farther
 /// than one box length outside the box, [-L, 2L) per coordinate: a file in other units or of
 /// another box. Positions a run has carried out of the box (tsi and the peer keep them
-/// unwrapped) are kept as they are within that margin; a run long enough to carry particles
-/// farther writes states this refuses (not yet wrapped on reading or writing).
+/// unwrapped) are kept as they are within that margin; tsi's state files (state.npy) hold them
+/// wrapped into the box, so a run of any length can be resumed from them.
 void check_positions(const RealVector& u, const Geometry& geometry, const std::string& file);
 
 }  // namespace tsi::pic

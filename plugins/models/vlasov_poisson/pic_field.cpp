@@ -116,8 +116,9 @@ void interpolate_all(const double* base, ParticleLayout layout, Index particles,
 double Geometry::length_x() const { return two_pi / k_x; }
 double Geometry::length_y() const { return two_pi / k_y; }
 
-Field::Field(const Geometry& geometry)
+Field::Field(const Geometry& geometry, const Collective* collective)
     : g_(geometry),
+      collective_(collective),
       width_(geometry.shape == Shape::cic ? 2 : 6),
       offset_(geometry.shape == Shape::cic ? 0 : 2),
       padded_x_(geometry.n_x + width_ - 1),
@@ -161,6 +162,7 @@ void Field::deposit(const double* base, ParticleLayout layout) {
     const double* from = padded_rho_.data() + J * padded_x_;
     for (Index I = 0; I < padded_x_; ++I) row[(I - offset_ + g_.n_x) % g_.n_x] += from[I];
   }
+  if (collective_) collective_->sum(rho, static_cast<Index>(g_.n_x) * g_.n_y);  // the whole plasma's
 }
 
 void Field::poisson() {
@@ -199,7 +201,10 @@ void Field::pad_field() {
 }
 
 void Field::solve(const double* base, ParticleLayout layout) {
-  if (same_positions(base, layout)) return;
+  // Split over processes, the last solve is reused only where every process's positions are
+  // its own last ones: all of them then skip the density's reduction together.
+  const bool same = same_positions(base, layout);
+  if (collective_ ? collective_->all(same) : same) return;
   deposit(base, layout);
   poisson();
   const Index ps = layout.particle_stride, cs = layout.component_stride;

@@ -6,6 +6,7 @@
 // to zero and the total momentum turns with the magnetic field).
 #include <memory>
 
+#include "tsi/collective.hpp"
 #include "tsi/spectral_grid.hpp"
 #include "tsi/types.hpp"
 
@@ -20,14 +21,17 @@ struct Geometry {
   int n_x = 16, n_y = 16;
   double k_x = 0.5, k_y = 1.0;
   Shape shape = Shape::m6;
-  Index particles = 1;
+  Index particles = 1;       ///< the particles this process holds
+  Index all_particles = 0;   ///< the plasma's, when split over processes (0: the same)
 
   double length_x() const;
   double length_y() const;
   double dx() const { return length_x() / n_x; }
   double dy() const { return length_y() / n_y; }
   /// |box| / N: the particles carry the box's unit mean density between them.
-  double weight() const { return length_x() * length_y() / static_cast<double>(particles); }
+  double weight() const {
+    return length_x() * length_y() / static_cast<double>(all_particles > 0 ? all_particles : particles);
+  }
 };
 
 /// Where a state column keeps particle k's x1, x2, v1, v2: at base[k * particle_stride +
@@ -41,10 +45,12 @@ struct ParticleLayout {
 /// per thread of a tau grid). Deposition and interpolation work on grids padded by the
 /// stencil's width (the nodes of a particle are contiguous there, never wrapped one by one);
 /// the padding is folded onto the periodic grid after a deposition and filled from it before
-/// an interpolation.
+/// an interpolation. With a Collective (a run split over processes), the density is summed
+/// over them before the solve, so every process has the whole plasma's field, and each call
+/// is collective: every process makes the same calls in the same order.
 class Field {
  public:
-  explicit Field(const Geometry& geometry);
+  explicit Field(const Geometry& geometry, const Collective* collective = nullptr);
   ~Field();
   Field(const Field&) = delete;
   Field& operator=(const Field&) = delete;
@@ -70,6 +76,7 @@ class Field {
   bool same_positions(const double* base, ParticleLayout layout) const;
 
   Geometry g_;
+  const Collective* collective_;
   int width_, offset_;          // stencil nodes first - offset .. first - offset + width - 1
   Index padded_x_, padded_y_;   // n + width - 1
   double inverse_dx_, inverse_dy_;

@@ -58,8 +58,9 @@ enum class TauField { per_tau, diagonal };
 
 class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, public tsi::PhysicalVariables {
  public:
-  VlasovPoisson2d(double eps, Geometry geometry, TauField tau_field, tsi::RealVector particles)
-      : Model(eps), g_(geometry), tau_field_(tau_field), u0_(std::move(particles)) {}
+  VlasovPoisson2d(double eps, Geometry geometry, TauField tau_field, tsi::RealVector particles,
+                  const tsi::Collective* collective)
+      : Model(eps), g_(geometry), tau_field_(tau_field), u0_(std::move(particles)), collective_(collective) {}
 
   const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
   const tsi::PhysicalVariables* physical_variables() const override { return this; }
@@ -103,8 +104,8 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   /// f_tau bound to a tau grid: its own field (buffers and transforms) and rotation tables.
   class GridField final : public tsi::TauGridField {
    public:
-    GridField(const Geometry& g, TauField tau_field, const tsi::RealVector& taus)
-        : g_(g), tau_field_(tau_field), field_(g), cos_(taus.array().cos()), sin_(taus.array().sin()) {}
+    GridField(const Geometry& g, TauField tau_field, const tsi::RealVector& taus, const tsi::Collective* collective)
+        : g_(g), tau_field_(tau_field), field_(g, collective), cos_(taus.array().cos()), sin_(taus.array().sin()) {}
     void evaluate(MatrixRef u, MatrixRef out) override {
       for (Index j = 0; j < u.cols(); ++j) {
         const double* column = reinterpret_cast<const double*>(u.col(j).data());
@@ -147,9 +148,10 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
     bool diagonal_solved_ = false;
   };
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
-    return std::make_unique<GridField>(g_, tau_field_, taus);
+    return std::make_unique<GridField>(g_, tau_field_, taus, collective_);
   }
-  bool independent_tau_grid_bindings() const override { return true; }
+  // Split over processes, the field's reductions must come in one order: one thread calls them.
+  bool independent_tau_grid_bindings() const override { return !collective_; }
   /// The filtered problem's f_tau, phases per call: through the model's one field (a binding
   /// per call would plan its transforms every time).
   void filtered_field(const tsi::RealVector& taus, MatrixRef u, MatrixRef out) const override {
@@ -166,13 +168,35 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   Index physical_dim() const override { return dim(); }
   Vector from_physical(const Vector& x) const override { return x; }
   Vector to_physical(const Vector& u) const override { return u; }
-  std::vector<Index> physical_shape() const override { return {g_.particles, 4}; }
+  std::vector<Index> physical_shape() const override {
+    return {g_.all_particles > 0 ? g_.all_particles : g_.particles, 4};  // the whole plasma's
+  }
+  double error_norm(const Vector& x) const override {
+    double squares = x.squaredNorm();
+    if (collective_) collective_->sum(&squares, 1);
+    return std::sqrt(squares);
+  }
+  bool split_across_processes() const override { return collective_ != nullptr; }
+  // The state files keep positions in the box (a run carries them out unwrapped, and a file
+  // farther out than a box length would be refused by check_positions).
+  void canonicalize_physical(Vector& x) const override {
+    const double lengths[2] = {g_.length_x(), g_.length_y()};
+    for (Index k = 0; k < x.size() / 4; ++k)
+      for (int c = 0; c < 2; ++c) {
+        double p = x(4 * k + c).real();
+        if (p >= 0.0 && p < lengths[c]) continue;
+        p -= lengths[c] * std::floor(p / lengths[c]);
+        x(4 * k + c) = p < lengths[c] ? p : 0.0;  // a rounding up to L is the box's 0
+      }
+  }
 
   std::vector<tsi::ModelInvariant> invariants() const override {
     const Geometry g = g_;
-    const auto kinetic = [g](const Vector& u) {
+    const tsi::Collective* collective = collective_;  // sums over the processes of a split run
+    const auto kinetic = [g, collective](const Vector& u) {
       double sum = 0.0;
       for (Index k = 0; k < g.particles; ++k) sum += std::norm(u(4 * k + 2)) + std::norm(u(4 * k + 3));
+      if (collective) collective->sum(&sum, 1);
       return 0.5 * g.weight() * sum;
     };
     return {
@@ -182,13 +206,14 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
            return kinetic(u) + field_of(u).field_energy();
          }},
         {"P", "|total momentum| |sum w v| (P turns with the field: R(t/eps) P(0))",
-         [g](const Vector& u) {
-           double p1 = 0.0, p2 = 0.0;
+         [g, collective](const Vector& u) {
+           double p[2] = {0.0, 0.0};
            for (Index k = 0; k < g.particles; ++k) {
-             p1 += u(4 * k + 2).real();
-             p2 += u(4 * k + 3).real();
+             p[0] += u(4 * k + 2).real();
+             p[1] += u(4 * k + 3).real();
            }
-           return g.weight() * std::hypot(p1, p2);
+           if (collective) collective->sum(p, 2);
+           return g.weight() * std::hypot(p[0], p[1]);
          }},
         {"Q", "total charge int rho (|box|: the deposition loses nothing)",
          [this](const Vector& u) {
@@ -207,7 +232,7 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   // The field of the calls that are not a tau-grid binding's (the filtered and direct
   // problems, the invariants), made once; callers hold mutex_.
   Field& shared_field() const {
-    if (!field_) field_ = std::make_unique<Field>(g_);
+    if (!field_) field_ = std::make_unique<Field>(g_, collective_);
     return *field_;
   }
   // The shared field solved for the positions of a model state (callers hold mutex_).
@@ -220,6 +245,7 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   Geometry g_;
   TauField tau_field_;
   tsi::RealVector u0_;
+  const tsi::Collective* collective_;  // the processes a split run's particles lie on, or null
   mutable std::mutex mutex_;
   mutable std::unique_ptr<Field> field_;
 };
@@ -291,7 +317,20 @@ void register_vlasov_poisson(tsi::Registry& registry) {
       particles = tsi::pic::sample_particles(g, distribution, p.number("alpha"), static_cast<std::uint64_t>(p.integer("seed")));
     }
     const TauField tau_field = p.string("tau_field") == "diagonal" ? TauField::diagonal : TauField::per_tau;
-    return std::make_unique<VlasovPoisson2d>(p.number("eps"), g, tau_field, std::move(particles));
+    // Split over processes (tsi run --split), this one keeps its contiguous block of particles.
+    const tsi::Collective* collective = p.context().collective;
+    if (collective) {
+      const tsi::Share share = tsi::share_of(g.particles, collective->rank(), collective->size());
+      if (g.particles < collective->size())  // refused by every process alike
+        throw tsi::ConfigError("model.particles",
+                               std::to_string(g.particles) + " particles cannot be split over " +
+                                   std::to_string(collective->size()) +
+                                   " processes; expected at least one particle per process");
+      particles = tsi::RealVector(particles.segment(4 * share.first, 4 * share.count));
+      g.all_particles = g.particles;
+      g.particles = share.count;
+    }
+    return std::make_unique<VlasovPoisson2d>(p.number("eps"), g, tau_field, std::move(particles), collective);
   };
   registry.add_model(std::move(entry));
 }
