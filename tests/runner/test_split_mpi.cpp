@@ -156,3 +156,31 @@ TEST_CASE("split run: what cannot be split is refused on every rank, said once, 
   CHECK_FALSE(t::fs::exists(dir.path() / "twice"));
 }
 #endif
+
+#ifdef TSI_TEST_MPIEXEC
+TEST_CASE("split run: SIGINT to mpirun stops every rank at one step, and rank 0 keeps the run up to it") {
+  t::TempDir dir("tsi-split-interrupt");
+  t::Json config = particle_config("etd2rk");
+  config["time"]["t_end"] = 4000 * pi_over_16;  // minutes: the signal comes first
+  config["output"] = {{"every", 1}};
+  t::CommandEnv env = t::mpirun_env();
+  env.send_signal = SIGINT;
+  env.signal_after_seconds = 2.0;
+  env.timeout_seconds = 300.0;  // a hung mpirun is killed, and the test fails
+  const t::CommandResult r = t::run_command(
+      TSI_TEST_MPIEXEC,
+      {"-np", "2", "--oversubscribe", "--allow-run-as-root", TSI_TEST_RUNNER, "run",
+       t::write_config(dir, config, "run.json"), "--out", dir / "out", "--split"},
+      env);
+  INFO(r.describe());
+  CHECK_FALSE(r.timed_out);
+  CHECK(r.exit_code != 0);
+  const t::Json record = t::read_json(dir.path() / "out/result.json");
+  CHECK(record["status"] == "interrupted");
+  const long steps = record["steps"].get<long>();
+  CHECK(steps > 0);
+  CHECK(steps < 4000);
+  CHECK(csv_rows(dir.path() / "out/invariants.csv").size() == static_cast<std::size_t>(steps + 1));
+  CHECK(tsi::read_npy_header(dir / "out/u_final.npy").shape == std::vector<std::uint64_t>{2048, 4});
+}
+#endif
