@@ -6,9 +6,16 @@ find_package(spdlog REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(Boost 1.74 REQUIRED)          # header-only: Boost.Odeint
 find_package(PkgConfig REQUIRED)
-pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
+# FFTW in the build's precision (TSI_PRECISION): libfftw3 or libfftw3l, both in libfftw3-dev.
+if(TSI_PRECISION STREQUAL "long-double")
+  pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3l)
+  set(TSI_FFTW_THREADS_NAME fftw3l_threads)
+else()
+  pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
+  set(TSI_FFTW_THREADS_NAME fftw3_threads)
+endif()
 # FFTW's thread support (libfftw3_threads, in the same Debian package) has no .pc file of its own.
-find_library(FFTW3_THREADS_LIBRARY NAMES fftw3_threads HINTS ${FFTW3_LIBRARY_DIRS} REQUIRED)
+find_library(FFTW3_THREADS_LIBRARY NAMES ${TSI_FFTW_THREADS_NAME} HINTS ${FFTW3_LIBRARY_DIRS} REQUIRED)
 find_package(Threads REQUIRED)
 
 # OpenMP (optional: GCC's libgomp; clang needs libomp-dev): one two-scale run splits a large

@@ -47,7 +47,7 @@ const ParamSchema& reference_schema() {
                    "the reference solver, or \"exact\": the model's exact solution where it declares one (the "
                    "matrix model with an affine field such as \"linear\"; the other keys are then unused)"),
       string_param("reformulation", "filtered", "the problem the reference solver integrates"),
-      number_param("tol", 1e-13, "the reference solver's tolerance").range(1e-16, 1e-1),
+      number_param("tol", 1e-13, "the reference solver's tolerance").range(smallest_tolerance, 1e-1),
       number_param("h", nullptr, "step of a non-adaptive reference solver; default: t_end")
           .range(0.0, std::numeric_limits<double>::infinity(), true),
       integer_param("n_tau", nullptr,

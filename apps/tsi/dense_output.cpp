@@ -49,14 +49,14 @@ void DenseOutput::finish() {
 }
 
 void DenseOutput::evaluate(const Pending& p, long last_available) {
-  const double t = times_[p.index];
+  const Real t = times_[p.index];
   const long last = std::min(p.last, last_available);
   // Lagrange's weights on the stencil's times t_i = i h (computed, not accumulated, as the
   // steps' own): exactly 1 and 0 at a step's own time, so a time on the grid is that step.
   Vector u = Vector::Zero(states_.at(p.first).size());
   for (long i = p.first; i <= last; ++i) {
-    const double ti = step_time(i, h_);
-    double w = 1.0;
+    const Real ti = step_time(i, h_);
+    Real w = 1;
     for (long k = p.first; k <= last; ++k)
       if (k != i) w *= (t - step_time(k, h_)) / (ti - step_time(k, h_));
     if (w != 0.0) u += w * states_.at(i);

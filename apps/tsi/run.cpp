@@ -39,7 +39,7 @@ double seconds_since(Clock::time_point start) {
 Json reference_scheme_section(const Json& ref, const SchemeEntry& scheme, double tol_factor, double substep_factor) {
   Json scheme_section = {{"name", scheme.info.name}};
   for (const auto& spec : scheme.info.params) {
-    if (spec.name == "tol") scheme_section["tol"] = std::max(1e-16, ref["tol"].get<double>() * tol_factor);
+    if (spec.name == "tol") scheme_section["tol"] = std::max(smallest_tolerance, ref["tol"].get<double>() * tol_factor);
     if (spec.name == "substeps_per_period")
       scheme_section["substeps_per_period"] = spec.default_value.get<double>() * substep_factor;
   }
@@ -67,7 +67,7 @@ Assembly reference_assembly(const Json& config, const Registry& registry, const 
 void check_reference_cost(const Json& config, const Assembly& a, const Json& scheme_section, double limit) {
   const Json& ref = config["reference"];
   const double t_end = config["time"]["t_end"];
-  const double period = a.reformulation->fast_period();
+  const double period = to_double(a.reformulation->fast_period());
   if (scheme_section.contains("substeps_per_period") && period > 0.0) {
     const double substeps = scheme_section["substeps_per_period"].get<double>();
     const double estimate = t_end / period * substeps;  // in double: 1e300 with eps = 1e-300
@@ -161,9 +161,9 @@ namespace {
 Vector final_model_state(Assembly& a, double t_end, long steps, const ProgressFn& progress, const char* what) {
   Vector y = a.reformulation->prepare(a.u0);
   auto last_progress = Clock::now();
-  integrate(a.bind(t_end / static_cast<double>(steps)), y, steps, [&](long n, double t, const Vector& state) {
-    if (!state.allFinite()) throw Error(fmt::format("{}: the state is not finite at t = {:.6g} (step {})", what, t, n));
-    if (interrupted()) throw Error(fmt::format("interrupted by signal {} at t = {:.6g}", interrupt_signal(), t));
+  integrate(a.bind(Real(t_end) / static_cast<Real>(steps)), y, steps, [&](long n, Real t, const Vector& state) {
+    if (!state.allFinite()) throw Error(fmt::format("{}: the state is not finite at t = {:.6g} (step {})", what, to_double(t), n));
+    if (interrupted()) throw Error(fmt::format("interrupted by signal {} at t = {:.6g}", interrupt_signal(), to_double(t)));
     if (progress && seconds_since(last_progress) > 0.5) {
       progress(static_cast<double>(n) / static_cast<double>(steps), what);
       last_progress = Clock::now();
@@ -203,7 +203,7 @@ ReferenceSolution compute_reference(const Json& config, const Registry& registry
     const Vector x0 = model->to_physical(initial_value(*model, without_name(config["model"])));
     const ExactSolution::Value exact = model->exact_solution()->at(x0, config["time"]["t_end"].get<double>());
     out.x = exact.x;
-    out.accuracy = exact.accuracy;
+    out.accuracy = to_double(exact.accuracy);
     out.wall_seconds = seconds_since(start);
     return out;
   }
@@ -215,8 +215,8 @@ ReferenceSolution compute_reference(const Json& config, const Registry& registry
   out.accuracy = std::numeric_limits<double>::quiet_NaN();
   if (out.settings.value("estimate_accuracy", true)) {
     const Vector tighter = model->to_physical(reference_model_state(config, registry, settings, 0.1, 2.0, progress, "reference check"));
-    out.accuracy = std::max(model->error_norm(out.x - tighter) / model->error_norm(tighter),
-                            model->rounding_floor(u));
+    out.accuracy = to_double(std::max(model->error_norm(out.x - tighter) / model->error_norm(tighter),
+                                      model->rounding_floor(u)));
   }
   return out;
 }
@@ -319,8 +319,8 @@ Json richardson_estimate(const Json& config, const Registry& registry, const Run
     out["wall_seconds"] = seconds_since(start);
     return out;
   }
-  const double scale = model.error_norm(x);
-  const double d = model.error_norm(x - fine) / scale, D = model.error_norm(coarse - x) / scale;
+  const Real scale = model.error_norm(x);
+  const double d = to_double(model.error_norm(x - fine) / scale), D = to_double(model.error_norm(coarse - x) / scale);
   const int low = std::max(1, traits.order), high = std::max(low, traits.classical_order);
   const double observed = d > 0.0 && D > 0.0 ? std::log2(D / d) : std::numeric_limits<double>::quiet_NaN();
   const bool asymptotic = std::isfinite(observed) && observed >= low - 0.5 && observed <= high + 0.5;
@@ -412,7 +412,7 @@ void agree_to_start(const Collective& split, const Json& config, const Registry&
   } catch (...) {
     failure = std::current_exception();
   }
-  double refused[2] = {failure ? 1.0 : 0.0, failure && split.rank() == 0 ? 1.0 : 0.0};  // anywhere, on rank 0
+  Real refused[2] = {failure ? Real(1) : Real(0), failure && split.rank() == 0 ? Real(1) : Real(0)};  // anywhere, on rank 0
   split.max(refused, 2);
   if (refused[0] == 0.0) return;
   if (failure && split.rank() != 0 && refused[1] != 0.0) {
@@ -452,8 +452,8 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
     if (!u0.allFinite())
       throw ConfigError("model.u0", "the initial value has non-finite entries; expected finite numbers");
     const bool hamiltonian = model->has_hamiltonian_structure();
-    const double H0 = hamiltonian ? model->energy(u0) : 0.0, I0 = hamiltonian ? model->oscillatory_energy(u0) : 0.0,
-                 m0 = hamiltonian ? model->mass(u0) : 0.0;
+    const Real H0 = hamiltonian ? model->energy(u0) : 0, I0 = hamiltonian ? model->oscillatory_energy(u0) : 0,
+               m0 = hamiltonian ? model->mass(u0) : 0;
     if (!std::isfinite(H0) || !std::isfinite(I0) || !std::isfinite(m0))
       throw ConfigError("model.u0", fmt::format("H = {}, I = {}, m = {} at the initial value; expected an initial "
                                                 "value whose invariants are finite numbers",
@@ -547,7 +547,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
             data_order, rconf["initial_data_order"].get<int>(), model->eps()));
     }
     stepper = &assembly.bind(config["time"]["h"].get<double>());
-    integrate(*stepper, y, n_steps, [&](long n, double t, const Vector& state) {
+    integrate(*stepper, y, n_steps, [&](long n, Real t, const Vector& state) {
       const bool go_on = recorder.observe(n, t, state);
       if (go_on && dense) dense->observe(n, state);  // a finite state only
       // A split run stops where any of its processes saw the signal, all at the same step.
@@ -571,10 +571,10 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
           for (const Index d : model->physical_shape()) shape.push_back(static_cast<std::uint64_t>(d));
           write_npy(stream_dir + "/state.npy", x, model->is_complex(), shape);
           result["state"] = {{"file", "state.npy"}, {"t", t}, {"step", n}};
-          checkpoint(n, t);
+          checkpoint(n, to_double(t));
         }
       }
-      if (go_on && !stream_dir.empty() && seconds_since(last_checkpoint) > checkpoint_seconds) checkpoint(n, t);
+      if (go_on && !stream_dir.empty() && seconds_since(last_checkpoint) > checkpoint_seconds) checkpoint(n, to_double(t));
       return go_on;
     }, reformulation->repreparation());
     if (status == "completed" && recorder.status() != "running") {

@@ -21,8 +21,8 @@
 namespace tsi::app {
 namespace {
 // |X - X0| / |X0| (absolute when X0 = 0).
-double relative_change(double value, double initial) {
-  return std::abs(value - initial) / (initial != 0.0 ? std::abs(initial) : 1.0);
+double relative_change(Real value, Real initial) {
+  return to_double(std::abs(value - initial) / (initial != 0 ? std::abs(initial) : Real(1)));
 }
 
 // A declared invariant's name and change column become columns of invariants.csv and its name a
@@ -54,7 +54,7 @@ RunRecorder::RunRecorder(const Model& model, Reformulation& reformulation, const
       csv_(hamiltonian_ ? "t,H,I,m,err_H,err_I,err_m,tau_roughness,tau_spread\n" : "t,tau_roughness,tau_spread\n") {
   // H, I and m exist only for a model that declares the Hamiltonian structure.
   if (hamiltonian_) {
-    const double initial[3] = {model.energy(u0), model.oscillatory_energy(u0), model.mass(u0)};
+    const Real initial[3] = {model.energy(u0), model.oscillatory_energy(u0), model.mass(u0)};
     for (int k = 0; k < 3; ++k) tracks_[k].initial = tracks_[k].final = initial[k];
   }
   std::set<std::string> taken = {"t", "H", "I", "m", "err_H", "err_I", "err_m", "tau_roughness", "tau_spread"};
@@ -149,7 +149,7 @@ double RunRecorder::drift(int k) const {
 
 bool RunRecorder::everywhere(bool flag) const { return collective_ ? collective_->all(flag) : flag; }
 
-bool RunRecorder::observe(long n, double t, const Vector& y) {
+bool RunRecorder::observe(long n, Real t, const Vector& y) {
   // Between the recorded steps (every output.every-th and the last) only the cheap check: the
   // problem state is finite. One pass over it, no read-back and no allocation.
   if (n % every_ != 0 && n != n_steps_) {
@@ -161,7 +161,7 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
     return false;
   }
   const Vector u = reformulation_.read_back(y, t);
-  double values[3] = {0.0, 0.0, 0.0};
+  Real values[3] = {0, 0, 0};
   if (hamiltonian_) values[0] = model_.energy(u), values[1] = model_.oscillatory_energy(u), values[2] = model_.mass(u);
   if (!everywhere(u.allFinite() && std::isfinite(values[0] + values[1] + values[2]))) {
     status_ = "blow-up";
@@ -175,7 +175,7 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
     tracks_[k].max_rel_error = std::max(tracks_[k].max_rel_error, errors[k]);
   }
   const TwoScaleDiagnostics* tau = reformulation_.two_scale_diagnostics();  // no tau: both 0
-  const double roughness = tau ? tau->tau_roughness(y) : 0.0;
+  const double roughness = tau ? to_double(tau->tau_roughness(y)) : 0.0;
   roughness_max_ = std::max(roughness_max_, roughness);
   if (roughness > roughness_warn_ && !roughness_warned_) {
     roughness_warned_ = true;
@@ -190,7 +190,7 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
   // the spread sits at 2.4e-6 while SE1 follows the solution, then grows a thousandfold within
   // 15 time units while the mass error goes from 1e-5 to 1, and the top of the tau spectrum
   // stays far below tau_roughness_warn.
-  const double spread = tau ? tau->tau_spread(y) : 0.0;
+  const double spread = tau ? to_double(tau->tau_spread(y)) : 0.0;
   spread_max_ = std::max(spread_max_, spread);
   // The baseline is the first recorded step's spread (step output.every, not always step 1).
   if (!spread_baseline_set_) {
@@ -208,10 +208,10 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
   }
   u_ = u;
   steps_ = n;
-  t_ = t;
+  t_ = to_double(t);
   for (auto& d : declared_) {
     d.final = d.invariant.value(u);
-    d.change = std::abs(d.final - d.initial) / (d.relative ? std::abs(d.initial) : 1.0);
+    d.change = to_double(std::abs(d.final - d.initial) / (d.relative ? std::abs(d.initial) : Real(1)));
     d.max_change = std::max(d.max_change, d.change);
     d.min = std::min(d.min, d.final);
     d.max = std::max(d.max, d.final);
@@ -224,13 +224,13 @@ bool RunRecorder::observe(long n, double t, const Vector& y) {
                                    : fmt::format("{:.17g},{:.6e},{:.6e}", t, roughness, spread);
     for (const auto& d : declared_)
       row += d.invariant.conserved ? fmt::format(",{:.17g},{:.6e}", d.final, d.change) : fmt::format(",{:.17g}", d.final);
-    write_row(row + "\n", t);
+    write_row(row + "\n", t_);
     if (t >= drift_from_)
       for (int k = 0; hamiltonian_ && k < 3; ++k) {
         // The printed value, as a drift fitted to the file would see it.
         const double printed = std::stod(fmt::format("{:.6e}", errors[k]));
         double* s = drift_sums_[k];
-        s[0] += 1, s[1] += t, s[2] += printed, s[3] += t * t, s[4] += t * printed;
+        s[0] += 1, s[1] += t_, s[2] += printed, s[3] += t_ * t_, s[4] += t_ * printed;
       }
   }
   if (blow_up) {

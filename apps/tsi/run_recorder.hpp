@@ -48,7 +48,7 @@ class RunRecorder {
 
   /// The step observer: false stops the integration. steps(), t_reached() and u_last() are
   /// those of the last recorded step.
-  bool observe(long n, double t, const Vector& y);
+  bool observe(long n, Real t, const Vector& y);
 
   /// Where the run stands: "running", or "blow-up" with a message.
   const std::string& status() const { return status_; }
@@ -73,7 +73,8 @@ class RunRecorder {
   // A flag of this process, over every process of a split run.
   bool everywhere(bool flag) const;
   struct Track {
-    double initial = 0.0, final = 0.0, max_rel_error = 0.0;
+    Real initial = 0, final = 0;  // in the build's precision: changes below double's are kept
+    double max_rel_error = 0.0;
   };
   /// A model's invariant: its column in invariants.csv is err_<name> (relative change) or
   /// abs_err_<name> (absolute change), after the value column <name>.
@@ -81,8 +82,9 @@ class RunRecorder {
     ModelInvariant invariant;
     bool relative = true;
     std::string column;
-    double initial = 0.0, final = 0.0, change = 0.0, max_change = 0.0;
-    double min = 0.0, max = 0.0;  // a diagnostic's range (conserved = false)
+    Real initial = 0, final = 0;
+    double change = 0.0, max_change = 0.0;
+    Real min = 0, max = 0;  // a diagnostic's range (conserved = false)
   };
   const Model& model_;
   const Collective* collective_ = nullptr;

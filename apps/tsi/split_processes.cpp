@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <type_traits>
 #include <vector>
 #endif
 
@@ -19,6 +20,9 @@ namespace tsi::app {
 
 #ifdef TSI_WITH_MPI
 namespace {
+
+// The build's Real as MPI sees it.
+const MPI_Datatype mpi_real = std::is_same_v<Real, double> ? MPI_DOUBLE : MPI_LONG_DOUBLE;
 
 class MpiWorld final : public Collective {
  public:
@@ -32,8 +36,8 @@ class MpiWorld final : public Collective {
 
   int rank() const override { return rank_; }
   int size() const override { return size_; }
-  void sum(double* values, Index n) const override { reduce(values, n, MPI_SUM); }
-  void max(double* values, Index n) const override { reduce(values, n, MPI_MAX); }
+  void sum(Real* values, Index n) const override { reduce(values, n, MPI_SUM); }
+  void max(Real* values, Index n) const override { reduce(values, n, MPI_MAX); }
   RealVector gather(const RealVector& local) const override {
     std::vector<int> counts(static_cast<size_t>(size_)), offsets(static_cast<size_t>(size_));
     const int count = checked_count(local.size());
@@ -44,7 +48,7 @@ class MpiWorld final : public Collective {
       total += counts[static_cast<size_t>(r)];
     }
     RealVector all(rank_ == 0 ? total : 0);
-    MPI_Gatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, 0,
+    MPI_Gatherv(local.data(), count, mpi_real, all.data(), counts.data(), offsets.data(), mpi_real, 0,
                 MPI_COMM_WORLD);
     return all;
   }
@@ -62,8 +66,8 @@ class MpiWorld final : public Collective {
       throw Error("--split: " + std::to_string(n) + " values in one MPI call, more than MPI's int counts hold");
     return static_cast<int>(n);
   }
-  static void reduce(double* values, Index n, MPI_Op op) {
-    MPI_Allreduce(MPI_IN_PLACE, values, checked_count(n), MPI_DOUBLE, op, MPI_COMM_WORLD);
+  static void reduce(Real* values, Index n, MPI_Op op) {
+    MPI_Allreduce(MPI_IN_PLACE, values, checked_count(n), mpi_real, op, MPI_COMM_WORLD);
   }
   int rank_ = 0, size_ = 1;
 };

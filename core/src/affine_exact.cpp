@@ -72,8 +72,8 @@ QuadMatrix exponential(const QuadMatrix& Z, int extra_squarings) {
 
 }  // namespace
 
-ExactSolution::Value affine_exact_solution(const Matrix& A, double eps, const AffineTerms& f, const Vector& u0,
-                                           double t) {
+ExactSolution::Value affine_exact_solution(const Matrix& A, Real eps, const AffineTerms& f, const Vector& u0,
+                                           Real t) {
   const Index n = A.rows();
   if (n > max_affine_exact_dim)
     throw Error(fmt::format("the exact solution of an affine field is offered up to {} unknowns, this one has {}",
@@ -106,7 +106,7 @@ ExactSolution::Value affine_exact_solution(const Matrix& A, double eps, const Af
     set(i, n, f.a(i));
     set(i, n + 1, f.b(i));
   }
-  set(n, n + 1, Complex(1.0));
+  set(n, n + 1, Complex(1));
   std::vector<Quad> z0(static_cast<std::size_t>(size), Quad(0));
   for (Index i = 0; i < n; ++i) {
     z0[static_cast<std::size_t>(i)] = u0(i).real();
@@ -125,13 +125,13 @@ ExactSolution::Value affine_exact_solution(const Matrix& A, double eps, const Af
   ExactSolution::Value out{Vector(n), 0.0};
   for (Index i = 0; i < n; ++i) {
     const auto re = static_cast<std::size_t>(i), im = static_cast<std::size_t>(i + m);
-    out.x(i) = Complex(static_cast<double>(z[re]), static_cast<double>(z[im]));
+    out.x(i) = Complex(static_cast<Real>(z[re]), static_cast<Real>(z[im]));
     norm2 += z[re] * z[re] + z[im] * z[im];
     diff2 += (z[re] - check[re]) * (z[re] - check[re]) + (z[im] - check[im]) * (z[im] - check[im]);
   }
-  const double norm = std::sqrt(static_cast<double>(norm2));
-  const double spread = norm > 0.0 ? std::sqrt(static_cast<double>(diff2)) / norm : 0.0;
-  out.accuracy = std::max(spread, std::numeric_limits<double>::epsilon() / 2.0);
+  const Real norm = std::sqrt(static_cast<Real>(norm2));
+  const Real spread = norm > 0 ? std::sqrt(static_cast<Real>(diff2)) / norm : 0;
+  out.accuracy = std::max(spread, std::numeric_limits<Real>::epsilon() / 2);
   return out;
 }
 

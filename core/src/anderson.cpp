@@ -8,8 +8,8 @@ namespace tsi {
 namespace {
 constexpr int max_depth = 8;
 // Small matrices with compile-time bounds: the least-squares solve never touches the heap.
-using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, max_depth, max_depth>;
-using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_depth, 1>;
+using SmallMatrix = Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic, 0, max_depth, max_depth>;
+using SmallVector = Eigen::Matrix<Real, Eigen::Dynamic, 1, 0, max_depth, 1>;
 }  // namespace
 
 double AndersonSolver::state_vectors_for(int depth) { return 4.0 + 2.0 * std::clamp(depth, 1, max_depth); }
@@ -17,7 +17,7 @@ double AndersonSolver::state_vectors_for(int depth) { return 4.0 + 2.0 * std::cl
 AndersonSolver::AndersonSolver(FixedPointOptions options)
     : FixedPointSolver(options), depth_(std::clamp(options.anderson_depth, 1, max_depth)) {}
 
-int AndersonSolver::iterate(Vector& x, FixedPointMap g, double& increment) {
+int AndersonSolver::iterate(Vector& x, FixedPointMap g, Real& increment) {
   if (residual_diffs_.size() != static_cast<size_t>(depth_)) residual_diffs_.resize(depth_), map_diffs_.resize(depth_);
   int stored = 0, next_column = 0;
   for (int k = 1; k <= options().max_iter; ++k) {

@@ -17,7 +17,7 @@ class AndersonSolver final : public FixedPointSolver {
   static double state_vectors_for(int depth);
 
  protected:
-  int iterate(Vector& x, FixedPointMap g, double& increment) override;
+  int iterate(Vector& x, FixedPointMap g, Real& increment) override;
 
  private:
   int depth_;

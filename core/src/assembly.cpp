@@ -320,7 +320,7 @@ Assembly assemble(const ResolvedSelection& resolved, const Registry& registry, c
   return a;
 }
 
-Stepper& Assembly::bind(double h) {
+Stepper& Assembly::bind(Real h) {
   stepper = scheme->bind(*reformulation, h);
   return *stepper;
 }

@@ -6,16 +6,16 @@
 
 namespace tsi {
 
-InterpolatoryWeights::InterpolatoryWeights(std::vector<double> nodes) : nodes_(std::move(nodes)) {
+InterpolatoryWeights::InterpolatoryWeights(std::vector<Real> nodes) : nodes_(std::move(nodes)) {
   const int r = static_cast<int>(nodes_.size());
   if (r < 1 || r > 20) throw std::invalid_argument("InterpolatoryWeights: 1 to 20 nodes");
-  monomials_.assign(r, std::vector<double>(r, 0.0));
+  monomials_.assign(r, std::vector<Real>(r, 0.0));
   for (int j = 0; j < r; ++j) {
-    std::vector<double> poly{1.0};  // increasing degree
-    double denominator = 1.0;
+    std::vector<Real> poly{1.0};  // increasing degree
+    Real denominator = 1.0;
     for (int i = 0; i < r; ++i) {
       if (i == j) continue;
-      std::vector<double> next(poly.size() + 1, 0.0);  // times (s - s_i)
+      std::vector<Real> next(poly.size() + 1, 0.0);  // times (s - s_i)
       for (size_t m = 0; m < poly.size(); ++m) {
         next[m] -= nodes_[i] * poly[m];
         next[m + 1] += poly[m];
@@ -27,10 +27,10 @@ InterpolatoryWeights::InterpolatoryWeights(std::vector<double> nodes) : nodes_(s
   }
 }
 
-std::vector<Complex> InterpolatoryWeights::operator()(double kappa, Complex z) const {
+std::vector<Complex> InterpolatoryWeights::operator()(Real kappa, Complex z) const {
   const int r = static_cast<int>(nodes_.size());
   std::vector<Complex> moments(r);  // int_0^kappa e^{(kappa - s) z} s^m ds
-  double factorial = 1.0, power = kappa;
+  Real factorial = 1.0, power = kappa;
   for (int m = 0; m < r; ++m) {
     if (m > 0) factorial *= m, power *= kappa;
     moments[m] = power * factorial * phi(m + 1, kappa * z);

@@ -48,15 +48,15 @@ FixedPointSolver::FixedPointSolver(FixedPointOptions options) : options_(std::mo
   stats_.sweeps_histogram.assign(static_cast<size_t>(std::min(options_.max_iter, 64)) + 1, 0);
 }
 
-double FixedPointSolver::increment(const Vector& next, const Vector& x) const {
-  double m[2];
+Real FixedPointSolver::increment(const Vector& next, const Vector& x) const {
+  Real m[2];
   algebra::increment_maxima(next, x, m);
   if (options_.collective) options_.collective->max(m, 2);
   return algebra::relative_increment(m);
 }
 
 bool FixedPointSolver::solve(Vector& x, FixedPointMap g) {
-  double increment = 0.0;
+  Real increment = 0.0;
   const int sweeps = iterate(x, g, increment);
   const bool converged = sweeps >= 0;
   const long used = converged ? sweeps : options_.max_iter;

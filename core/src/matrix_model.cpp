@@ -24,7 +24,7 @@ void Field::derivative(const RealVector&, ConstMatrixRef, ConstMatrixRef, Matrix
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+constexpr Real two_pi = 2 * std::numbers::pi_v<Real>;
 
 // A JSON value as a short text for a message (a large matrix is cut).
 std::string shown(const Json& v) {
@@ -99,10 +99,10 @@ PeriodicMatrixFlow::PeriodicMatrixFlow(Matrix A, const std::string& path) : A_(s
   if (n == 0 || A_.cols() != n) throw ConfigError(path, fmt::format("is {} x {}, expected a nonempty square matrix", n, A_.cols()));
   if (!A_.allFinite()) throw ConfigError(path, "has an entry that is not finite");
   real_ = A_.imag().isZero(0.0);
-  const double norm = A_.cwiseAbs().rowwise().sum().maxCoeff();
+  const Real norm = A_.cwiseAbs().rowwise().sum().maxCoeff();
   const Matrix period = (Complex(two_pi) * A_).exp();
   deviation_ = (period - Matrix::Identity(n, n)).cwiseAbs().maxCoeff();
-  const double tolerance = 1e-9 * std::max(1.0, two_pi * norm);
+  const Real tolerance = Real(1e-9) * std::max<Real>(1, two_pi * norm);
   if (!(deviation_ <= tolerance))
     throw ConfigError(path, fmt::format("e^(2 pi A) differs from the identity by {:.3g} (its largest entry of "
                                         "e^(2 pi A) - I), expected at most {:.3g} (1e-9 max(1, 2 pi |A|)): "
@@ -113,7 +113,7 @@ PeriodicMatrixFlow::PeriodicMatrixFlow(Matrix A, const std::string& path) : A_(s
   const Eigen::ComplexEigenSolver<Matrix> solver(A_, false);
   std::set<long> ks;
   for (Index i = 0; i < n; ++i) {
-    const double k = solver.eigenvalues()(i).imag();
+    const Real k = solver.eigenvalues()(i).imag();
     if (!(std::fabs(k) <= 1e6))
       throw ConfigError(path, fmt::format("has the eigenvalue {:.6g}i: frequencies up to 1e6 are taken (the fast "
                                           "frequency is 1/eps: scale A so that it is)",
@@ -132,17 +132,17 @@ PeriodicMatrixFlow::PeriodicMatrixFlow(Matrix A, const std::string& path) : A_(s
   frequencies_.assign(ks.begin(), ks.end());
   projectors_.assign(frequencies_.size(), Matrix::Zero(n, n));
   for (long j = 0; j < samples; ++j) {
-    const double tau = two_pi * static_cast<double>(j) / static_cast<double>(samples);
+    const Real tau = two_pi * static_cast<Real>(j) / static_cast<Real>(samples);
     const Matrix E = (Complex(tau) * A_).exp();
     for (std::size_t m = 0; m < frequencies_.size(); ++m)
-      projectors_[m] += std::polar(1.0 / static_cast<double>(samples), -static_cast<double>(frequencies_[m]) * tau) * E;
+      projectors_[m] += std::polar(1 / static_cast<Real>(samples), -static_cast<Real>(frequencies_[m]) * tau) * E;
   }
 }
 
-Matrix PeriodicMatrixFlow::at(double tau) const {
+Matrix PeriodicMatrixFlow::at(Real tau) const {
   Matrix E = Matrix::Zero(dim(), dim());
   for (std::size_t m = 0; m < frequencies_.size(); ++m)
-    E += std::polar(1.0, static_cast<double>(frequencies_[m]) * tau) * projectors_[m];
+    E += std::polar(Real(1), static_cast<Real>(frequencies_[m]) * tau) * projectors_[m];
   if (real_) E.imag().setZero();
   return E;
 }
@@ -151,7 +151,7 @@ namespace {
 
 class MatrixModel final : public Model, public FusedTauGrid, public PhysicalVariables {
  public:
-  MatrixModel(double eps, PeriodicMatrixFlow flow, std::shared_ptr<const Field> field, bool time_dependent,
+  MatrixModel(Real eps, PeriodicMatrixFlow flow, std::shared_ptr<const Field> field, bool time_dependent,
               bool is_complex, Vector u0, std::string field_name)
       : Model(eps),
         flow_(std::move(flow)),
@@ -275,12 +275,12 @@ class MatrixModel final : public Model, public FusedTauGrid, public PhysicalVari
 
   class AffineExact final : public ExactSolution {
    public:
-    AffineExact(Matrix A, double eps, AffineTerms terms) : A_(std::move(A)), eps_(eps), terms_(std::move(terms)) {}
-    Value at(const Vector& x0, double t) const override { return affine_exact_solution(A_, eps_, terms_, x0, t); }
+    AffineExact(Matrix A, Real eps, AffineTerms terms) : A_(std::move(A)), eps_(eps), terms_(std::move(terms)) {}
+    Value at(const Vector& x0, Real t) const override { return affine_exact_solution(A_, eps_, terms_, x0, t); }
 
    private:
     Matrix A_;
-    double eps_;
+    Real eps_;
     AffineTerms terms_;
   };
 
@@ -300,7 +300,7 @@ class QuickstartField final : public Field {
     for (Index j = 0; j < u.cols(); ++j) {
       out(0, j) = 0.0;
       out(1, j) = u(3, j);
-      out(2, j) = 2.0 * u(0, j) * u(1, j);
+      out(2, j) = Real(2) * u(0, j) * u(1, j);
       out(3, j) = -u(1, j) - u(0, j) * u(0, j) + u(1, j) * u(1, j);
     }
   }
@@ -309,8 +309,8 @@ class QuickstartField final : public Field {
     for (Index j = 0; j < u.cols(); ++j) {
       out(0, j) = 0.0;
       out(1, j) = z(3, j);
-      out(2, j) = 2.0 * (z(0, j) * u(1, j) + u(0, j) * z(1, j));
-      out(3, j) = -z(1, j) - 2.0 * u(0, j) * z(0, j) + 2.0 * u(1, j) * z(1, j);
+      out(2, j) = Real(2) * (z(0, j) * u(1, j) + u(0, j) * z(1, j));
+      out(3, j) = -z(1, j) - Real(2) * u(0, j) * z(0, j) + Real(2) * u(1, j) * z(1, j);
     }
   }
 };
@@ -348,7 +348,7 @@ Json quickstart_A() {
 
 }  // namespace
 
-std::unique_ptr<Model> make_matrix_model(double eps, PeriodicMatrixFlow flow, std::shared_ptr<const Field> field,
+std::unique_ptr<Model> make_matrix_model(Real eps, PeriodicMatrixFlow flow, std::shared_ptr<const Field> field,
                                          bool time_dependent, bool is_complex, Vector u0, std::string field_name) {
   if (!field) throw Error("make_matrix_model: no field");
   return std::make_unique<MatrixModel>(eps, std::move(flow), std::move(field), time_dependent, is_complex,

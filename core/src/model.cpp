@@ -8,17 +8,17 @@
 
 namespace tsi {
 
-Model::Model(double eps) : eps_(eps) {
+Model::Model(Real eps) : eps_(eps) {
   if (!(eps > 0.0 && eps <= 1.0)) throw ConfigError("model.eps", "expected a number in (0, 1]");
 }
 
 void Model::nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef directions,
                                        MatrixRef out) const {
   // Central difference with a step balancing truncation (delta^2) and rounding (1/delta).
-  const double delta = std::cbrt(std::numeric_limits<double>::epsilon());
+  const Real delta = std::cbrt(std::numeric_limits<Real>::epsilon());
   Matrix plus(states.rows(), states.cols()), minus(states.rows(), states.cols());
   for (Index j = 0; j < states.cols(); ++j) {
-    const double scale = std::max(1.0, states.col(j).norm()) / std::max(directions.col(j).norm(), 1e-300);
+    const Real scale = std::max<Real>(1, states.col(j).norm()) / std::max<Real>(directions.col(j).norm(), 1e-300);
     plus.col(j) = states.col(j) + delta * scale * directions.col(j);
     minus.col(j) = states.col(j) - delta * scale * directions.col(j);
   }
@@ -26,12 +26,12 @@ void Model::nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef dir
   nonlinear_field(plus, f_plus);
   nonlinear_field(minus, f_minus);
   for (Index j = 0; j < states.cols(); ++j) {
-    const double dn = directions.col(j).norm();
+    const Real dn = directions.col(j).norm();
     if (dn == 0.0) {
       out.col(j).setZero();
       continue;
     }
-    const double scale = std::max(1.0, states.col(j).norm()) / dn;
+    const Real scale = std::max<Real>(1, states.col(j).norm()) / dn;
     out.col(j) = (f_plus.col(j) - f_minus.col(j)) / (2.0 * delta * scale);
   }
 }
@@ -93,13 +93,13 @@ const RealVector& Model::linear_remainder() const {
   return none;
 }
 
-void Model::remainder_flow(double t, Vector& u) const {
+void Model::remainder_flow(Real t, Vector& u) const {
   const RealVector& omega = linear_remainder();
   if (omega.size() == 0) return;
-  for (Index j = 0; j < u.size(); ++j) u(j) *= std::polar(1.0, omega(j) * t);
+  for (Index j = 0; j < u.size(); ++j) u(j) *= std::polar(Real(1), omega(j) * t);
 }
 
-double Model::remainder_energy(const Vector& u) const {
+Real Model::remainder_energy(const Vector& u) const {
   const RealVector& omega = linear_remainder();
   if (omega.size() == 0) return 0.0;
   const HamiltonianStructure* h = hamiltonian();
@@ -119,13 +119,13 @@ void Model::apply_A(const Vector& u, Vector& out) const {
   h->apply_J(mu, out);
 }
 
-void Model::nonlinear_flow(double t, Vector& u) const {
+void Model::nonlinear_flow(Real t, Vector& u) const {
   const ExactNonlinearFlow* flow = exact_nonlinear_flow();
   if (!flow) throw Error("this model has no exact nonlinear flow (Model::exact_nonlinear_flow() is null)");
   flow->nonlinear_flow(t, u);
 }
 
-double Model::oscillatory_energy(const Vector& u) const {
+Real Model::oscillatory_energy(const Vector& u) const {
   const HamiltonianStructure* h = hamiltonian();
   if (!h) no_hamiltonian("oscillatory energy");
   Vector mu(u.size());
@@ -133,9 +133,9 @@ double Model::oscillatory_energy(const Vector& u) const {
   return inner(mu, u) / (2.0 * eps_);
 }
 
-double Model::mass(const Vector& u) const { return inner(u, u); }
+Real Model::mass(const Vector& u) const { return inner(u, u); }
 
-double Model::energy(const Vector& u) const {
+Real Model::energy(const Vector& u) const {
   const HamiltonianStructure* h = hamiltonian();
   if (!h) no_hamiltonian("energy");
   return oscillatory_energy(u) + remainder_energy(u) + h->H1(u);
@@ -161,22 +161,22 @@ Vector Model::to_physical(const Vector& u) const {
   return p ? p->to_physical(u) : u;
 }
 
-double Model::error_norm(const Vector& x) const {
+Real Model::error_norm(const Vector& x) const {
   const PhysicalVariables* p = physical_variables();
   return p ? p->error_norm(x) : x.norm();
 }
 
-double Model::rounding_floor(const Vector& u) const {
+Real Model::rounding_floor(const Vector& u) const {
   Vector rounded = u;
   for (Index i = 0; i < u.size(); ++i) {
-    const double sign = i % 2 == 0 ? 1.0 : -1.0, ulp = std::numeric_limits<double>::epsilon();
+    const Real sign = i % 2 == 0 ? 1.0 : -1.0, ulp = std::numeric_limits<Real>::epsilon();
     rounded(i) = Complex(u(i).real() * (1.0 + sign * ulp), u(i).imag() * (1.0 - sign * ulp));
   }
   const Vector x = to_physical(u);
-  return error_norm(to_physical(rounded) - x) / std::max(error_norm(x), 1e-300);
+  return error_norm(to_physical(rounded) - x) / std::max<Real>(error_norm(x), 1e-300);
 }
 
-Vector Model::linear_flow(double tau, const Vector& u) const {
+Vector Model::linear_flow(Real tau, const Vector& u) const {
   Matrix states = u;
   RealVector taus(1);
   taus(0) = tau;

@@ -18,17 +18,17 @@
 namespace tsi {
 namespace {
 
-constexpr double t_end = 1.0;
+constexpr Real t_end = 1.0;
 
-constexpr double reference_tol = 1e-14;
-constexpr double order_margin = 0.2, high_order_margin = 0.5;
-constexpr double symmetry_step = 0.25, symmetry_limit = 1e-10;
+constexpr Real reference_tol = 1e-14;
+constexpr Real order_margin = 0.2, high_order_margin = 0.5;
+constexpr Real symmetry_step = 0.25, symmetry_limit = 1e-10;
 // Errors below this measure the reference and the tau resolution (n_tau), not the scheme:
 // they are left out of the order fit (a round-off plateau filter).
-constexpr double error_floor = 1e-7;
+constexpr Real error_floor = 1e-7;
 // Orders above 2 fall below 1e-7 within the steps checked: their errors are fitted down to
 // this on twice the tau grid, still above the reference's accuracy at reference_tol.
-constexpr double envelope_floor = 1e-10;
+constexpr Real envelope_floor = 1e-10;
 // A model's default n_tau resolves tau to the errors of order 2; the higher orders reach the
 // tau grid's own error (NLS at eps = 1, n_tau = 256: 2.2e-8), so they run on twice the grid.
 constexpr int high_order_tau_factor = 2;
@@ -36,7 +36,7 @@ constexpr int high_order_tau_factor = 2;
 // grid and are fitted down to envelope_floor; order 2 on the model's grid down to error_floor.
 bool high_order(const StepperTraits& t) { return t.order > 2 || t.classical_order > t.order; }
 int tau_factor(const StepperTraits& t) { return high_order(t) ? high_order_tau_factor : 1; }
-double fit_floor(const StepperTraits& t) { return high_order(t) ? envelope_floor : error_floor; }
+Real fit_floor(const StepperTraits& t) { return high_order(t) ? envelope_floor : error_floor; }
 // The eps log-spaced over the given range for the maximum over eps (besides the given ones and
 // the step-size resonances inside it).
 constexpr int dense_eps_points = 32;
@@ -44,25 +44,25 @@ constexpr int dense_eps_points = 32;
 
 
 /// A state of the model's kind away from any special point: u0 plus a fixed perturbation.
-Vector sample_state(const Model& model, const Vector& u0, double phase) {
-  const double scale = std::max(max_norm(u0), 0.1);
+Vector sample_state(const Model& model, const Vector& u0, Real phase) {
+  const Real scale = std::max<Real>(max_norm(u0), 0.1);
   Vector w = u0;
   for (Index i = 0; i < w.size(); ++i) {
-    const double a = std::sin(1.7 * static_cast<double>(i) + phase),
-                 b = std::cos(0.9 * static_cast<double>(i) + 2 * phase);
-    w(i) += 0.1 * scale * (model.is_complex() ? Complex(a, b) : Complex(a, 0.0));
+    const Real a = std::sin(1.7 * static_cast<Real>(i) + phase),
+                 b = std::cos(0.9 * static_cast<Real>(i) + 2 * phase);
+    w(i) += Real(0.1) * scale * (model.is_complex() ? Complex(a, b) : Complex(a, 0));
   }
   return w;
 }
 
 /// The steps that lie close to a whole number of half fast periods (pi eps), within 0.06 of
 /// one, as "h = 1/16, h = 1/32 are" (empty when none).
-std::string resonant_steps(const std::vector<long>& steps, double eps, double max_half_periods = 1e300) {
+std::string resonant_steps(const std::vector<long>& steps, Real eps, Real max_half_periods = 1e300) {
   std::string out;
   int count = 0;
   for (const long n : steps) {
-    const double half_periods = 1.0 / (static_cast<double>(n) * 0.5 * two_pi * eps);
-    const double nearest = std::round(half_periods);
+    const Real half_periods = 1.0 / (static_cast<Real>(n) * 0.5 * two_pi * eps);
+    const Real nearest = std::round(half_periods);
     if (nearest >= 1.0 && nearest <= max_half_periods && std::abs(half_periods - nearest) <= 0.06) {
       out += fmt::format("{}h = 1/{}", out.empty() ? "" : ", ", n);
       ++count;
@@ -71,8 +71,8 @@ std::string resonant_steps(const std::vector<long>& steps, double eps, double ma
   return out.empty() ? out : out + (count > 1 ? " are" : " is");
 }
 
-double relative(const Vector& a, const Vector& b, double scale) {
-  return max_norm(a - b) / std::max(scale, 1e-300);
+Real relative(const Vector& a, const Vector& b, Real scale) {
+  return max_norm(a - b) / std::max<Real>(scale, 1e-300);
 }
 
 /// The checks of one model, printed as they run; failures are collected for the summary.
@@ -85,8 +85,8 @@ class ModelChecks {
     for (const long n : options_.steps) finer_steps_.push_back(4 * n);
   }
 
-  void interface(double eps);
-  void convergence(const std::vector<const SchemeEntry*>& schemes, const std::vector<double>& epsilons);
+  void interface(Real eps);
+  void convergence(const std::vector<const SchemeEntry*>& schemes, const std::vector<Real>& epsilons);
 
   /// A failure outside any single check (the model could not even be built).
   void fail(const std::string& why) {
@@ -96,7 +96,7 @@ class ModelChecks {
   const std::vector<std::string>& failures() const { return failures_; }
   const std::vector<std::string>& undecided() const { return undecidable_; }
   /// The model section of the checks' configs: the user's --set model parameters and eps.
-  Json model_section(double eps) const {
+  Json model_section(Real eps) const {
     Json m = options_.model_params;
     m["name"] = entry_.info.name;
     m["eps"] = eps;
@@ -116,7 +116,7 @@ class ModelChecks {
     r["name"] = name;
     return r;
   }
-  std::shared_ptr<const Model> model(double eps) const {
+  std::shared_ptr<const Model> model(Real eps) const {
     Json params = model_section(eps);
     params.erase("name");
     return entry_.create(Params(resolve_params(entry_.info.params, params, "model")));
@@ -136,7 +136,7 @@ class ModelChecks {
     fmt::print(out_, "    {:<5} {}\n", ok ? "ok" : "FAIL", line);
     if (!ok) failures_.push_back(failure + (hint.empty() ? "" : "\n      " + hint));
   }
-  void check(const std::string& what, double value, double limit, const std::string& hint) {
+  void check(const std::string& what, Real value, Real limit, const std::string& hint) {
     const bool ok = std::isfinite(value) && value <= limit;
     report(ok, fmt::format("{:<52} {:>9.2e} {:>9.0e}", what, value, limit),
            fmt::format("{}: {:.2e} exceeds {:.0e}", what, value, limit), hint);
@@ -144,7 +144,7 @@ class ModelChecks {
 
   /// A run's objects through the core's assembler (as `tsi run` builds them): the scheme's tol
   /// and max_iter where it takes them, every other default completed by the entries.
-  Assembly assembly(const SchemeEntry& scheme, const std::string& reformulation, double eps, double tol,
+  Assembly assembly(const SchemeEntry& scheme, const std::string& reformulation, Real eps, Real tol,
                     int max_iter) const {
     Json scheme_section = {{"name", scheme.info.name}};
     for (const auto& p : scheme.info.params) {
@@ -159,28 +159,28 @@ class ModelChecks {
   }
   /// What limits h for this model whatever eps: the size of J Hess H1 at u0 (a power
   /// iteration on nonlinear_field_derivative). An explicit treatment of H1 needs h L <~ 2.
-  double field_stiffness(double eps) const;
+  Real field_stiffness(Real eps) const;
   /// The measured cause of a missed order, as advice (empty when nothing stands out).
-  std::string diagnose(const SchemeEntry& scheme, double eps, const Vector& x_ref) const;
-  Vector reference(std::shared_ptr<const Model> m, const Vector& u0, double tol = reference_tol) const;
+  std::string diagnose(const SchemeEntry& scheme, Real eps, const Vector& x_ref) const;
+  Vector reference(std::shared_ptr<const Model> m, const Vector& u0, Real tol = reference_tol) const;
   /// Below this an error measures the reference: twice its change from tol to 10 tol (which is
   /// about 6x its error at tol; Klein-Gordon at eps = 1e-4: 2.5e-9 at tol 1e-14), at least `floor`.
-  double reference_floor(double eps, double floor) const {
+  Real reference_floor(Real eps, Real floor) const {
     const auto it = reference_accuracy_.find(eps);
     return std::max(floor, it == reference_accuracy_.end() ? 0.0 : 2.0 * it->second);
   }
-  std::map<double, double> reference_accuracy_;
+  std::map<Real, Real> reference_accuracy_;
   /// The relative errors at T for the given numbers of steps.
-  std::vector<double> errors(const SchemeEntry& scheme, double eps, const Vector& x_ref,
+  std::vector<Real> errors(const SchemeEntry& scheme, Real eps, const Vector& x_ref,
                              const std::vector<long>& steps, int n_tau_factor = 1, int data_order = 0) const;
   /// The errors at eps for the checked steps, computed once per scheme and eps.
-  std::vector<double> errors_at(const SchemeEntry& scheme, double eps, const Vector& x_ref);
-  std::map<std::pair<std::string, double>, std::vector<double>> errors_;
+  std::vector<Real> errors_at(const SchemeEntry& scheme, Real eps, const Vector& x_ref);
+  std::map<std::pair<std::string, Real>, std::vector<Real>> errors_;
   /// One eps's row (information).
-  void orders(const SchemeEntry& scheme, double eps, const std::vector<double>& errs);
+  void orders(const SchemeEntry& scheme, Real eps, const std::vector<Real>& errs);
   /// The verdict: the order of the maximum error over the eps sample.
-  void envelope(const SchemeEntry& scheme, const std::vector<double>& sample, const std::map<double, Vector>& references);
-  void symmetry(const SchemeEntry& scheme, double eps);
+  void envelope(const SchemeEntry& scheme, const std::vector<Real>& sample, const std::map<Real, Vector>& references);
+  void symmetry(const SchemeEntry& scheme, Real eps);
 
   const Registry& registry_;
   const ModelEntry& entry_;
@@ -191,7 +191,7 @@ class ModelChecks {
   int count_ = 0;
 };
 
-void ModelChecks::interface(double eps) {
+void ModelChecks::interface(Real eps) {
   fmt::print(out_, "  {:<60} {:>9} {:>9}\n", fmt::format("interface at eps = {:g}", eps), "value", "limit");
   const auto m = model(eps);
   const Model& mod = *m;
@@ -203,7 +203,7 @@ void ModelChecks::interface(double eps) {
          "dim() is the number of entries of u; initial_value() returns u0 in model variables");
   if (!sized) return;
   const Vector w = sample_state(mod, u0, 0.3), z = sample_state(mod, Vector::Zero(n), 1.1);
-  const double w_norm = max_norm(w);
+  const Real w_norm = max_norm(w);
 
   check("linear_flow(2 pi) u = u", relative(mod.linear_flow(two_pi, w), w, w_norm), 1e-10,
         "linear_flow(tau) must be e^{JM tau}, 2 pi periodic: JM has eigenvalues i k with integer k "
@@ -226,10 +226,10 @@ void ModelChecks::interface(double eps) {
   } else {
     mod.apply_A(w, au);
   }
-  const double omega = mod.max_linear_frequency(), delta = 1e-5 / omega;
+  const Real omega = mod.max_linear_frequency(), delta = 1e-5 / omega;
   const Vector derivative = (mod.linear_flow(delta, w) - mod.linear_flow(-delta, w)) / (2 * delta);
   check(hamiltonian ? "d/dtau linear_flow(tau) u at 0 = J M u" : "d/dtau linear_flow(tau) u at 0 = A u",
-        relative(derivative, au, std::max(max_norm(au), omega * w_norm)), 1e-6,
+        relative(derivative, au, std::max<Real>(max_norm(au), omega * w_norm)), 1e-6,
         hamiltonian ? "the flow must be generated by apply_J(apply_M(u)): the flow, M and J disagree (a sign or a factor)"
                     : "the flow must be generated by apply_A(u): the flow and A disagree (a sign or a factor)");
 
@@ -255,15 +255,15 @@ void ModelChecks::interface(double eps) {
   mod.linear_flow(taus, flowed);
   mod.nonlinear_field(states, field);
   mod.nonlinear_field_derivative(states, dirs, dfield);
-  double batch = 0.0;
+  Real batch = 0.0;
   for (Index j = 0; j < 3; ++j) {
     Matrix f1(n, 1), d1(n, 1);
     mod.nonlinear_field(states.col(j), f1);
     mod.nonlinear_field_derivative(states.col(j), dirs.col(j), d1);
-    const double scale = max_norm(states.col(j));
-    batch = std::max({batch, relative(flowed.col(j), mod.linear_flow(taus(j), states.col(j)), scale),
-                      relative(field.col(j), f1.col(0), std::max(max_norm(f1.col(0)), scale)),
-                      relative(dfield.col(j), d1.col(0), std::max(max_norm(d1.col(0)), scale))});
+    const Real scale = max_norm(states.col(j));
+    batch = std::max<Real>({batch, relative(flowed.col(j), mod.linear_flow(taus(j), states.col(j)), scale),
+                      relative(field.col(j), f1.col(0), std::max<Real>(max_norm(f1.col(0)), scale)),
+                      relative(dfield.col(j), d1.col(0), std::max<Real>(max_norm(d1.col(0)), scale))});
   }
   // filtered_field against its definition (a model may fuse the three steps).
   Matrix scratch = states, fused(n, 3), composed = states, field_back(n, 3);
@@ -274,9 +274,9 @@ void ModelChecks::interface(double eps) {
   mod.linear_flow(minus_taus, field_back);
   Matrix bound_scratch = states, bound(n, 3);
   mod.bind_tau_grid(taus)->evaluate(bound_scratch, bound);
-  double fused_error = 0.0;
+  Real fused_error = 0.0;
   for (Index j = 0; j < 3; ++j) {
-    const double scale = std::max(max_norm(field_back.col(j)), 1e-300);
+    const Real scale = std::max<Real>(max_norm(field_back.col(j)), 1e-300);
     fused_error = std::max({fused_error, relative(fused.col(j), field_back.col(j), scale),
                             relative(bound.col(j), field_back.col(j), scale)});
   }
@@ -294,14 +294,14 @@ void ModelChecks::interface(double eps) {
     mod.nonlinear_field(rw, f);
     mod.nonlinear_field_derivative(rw, rz, d);
     const Vector fl = mod.linear_flow(1.3, rw);
-    const double imag = std::max({fl.imag().cwiseAbs().maxCoeff() / max_norm(rw),
-                                  f.imag().cwiseAbs().maxCoeff() / std::max(max_norm(f.col(0)), 1e-300),
-                                  d.imag().cwiseAbs().maxCoeff() / std::max(max_norm(d.col(0)), 1e-300)});
+    const Real imag = std::max<Real>({fl.imag().cwiseAbs().maxCoeff() / max_norm(rw),
+                                  f.imag().cwiseAbs().maxCoeff() / std::max<Real>(max_norm(f.col(0)), 1e-300),
+                                  d.imag().cwiseAbs().maxCoeff() / std::max<Real>(max_norm(d.col(0)), 1e-300)});
     check("real states stay real (is_complex() is false)", imag, 1e-14,
           "a real model keeps zero imaginary parts in linear_flow and nonlinear_field");
   }
 
-  const double h = 1e-6 * std::max(1.0, w_norm);
+  const Real h = 1e-6 * std::max<Real>(1, w_norm);
   Matrix plus(n, 1), minus(n, 1), analytic(n, 1);
   mod.nonlinear_field(w + h * z, plus);
   mod.nonlinear_field(w - h * z, minus);
@@ -309,20 +309,20 @@ void ModelChecks::interface(double eps) {
   const Vector quotient = (plus - minus).col(0) / (2 * h);
   check("nonlinear_field_derivative = difference quotient",
         relative(analytic.col(0), quotient,
-                 std::max({max_norm(quotient), max_norm(plus.col(0)) / w_norm, 1e-12})),
+                 std::max<Real>({max_norm(quotient), max_norm(plus.col(0)) / w_norm, 1e-12})),
         1e-6, "nonlinear_field_derivative(u, z) must be J Hess H1(u) z, the derivative of nonlinear_field");
 }
 
-Vector ModelChecks::reference(std::shared_ptr<const Model> m, const Vector& u0, double tol) const {
+Vector ModelChecks::reference(std::shared_ptr<const Model> m, const Vector& u0, Real tol) const {
   Assembly a = assembly(registry_.scheme("rk78", "reference.scheme"), "filtered", m->eps(), tol, 200);
   Vector y = a.reformulation->prepare(u0);
   integrate(a.bind(t_end), y, 1, {}, a.reformulation->repreparation());
   return a.reformulation->read_back(y, t_end);
 }
 
-std::vector<double> ModelChecks::errors(const SchemeEntry& scheme, double eps, const Vector& x_ref,
+std::vector<Real> ModelChecks::errors(const SchemeEntry& scheme, Real eps, const Vector& x_ref,
                                         const std::vector<long>& steps, int n_tau_factor, int data_order) const {
-  std::vector<double> out;
+  std::vector<Real> out;
   for (const long n : steps) {
     Assembly a = assembly(scheme, "two-scale", eps, 1e-14, 1000);
     if (n_tau_factor != 1 || data_order > 0) {  // the same run on a finer tau grid, or other data
@@ -337,9 +337,9 @@ std::vector<double> ModelChecks::errors(const SchemeEntry& scheme, double eps, c
         if (p.name == "tol") config["scheme"]["tol"] = 1e-14;
       a = assemble_config(config, registry_);
     }
-    const double h = t_end / static_cast<double>(n);
+    const Real h = t_end / static_cast<Real>(n);
     Vector y = a.reformulation->prepare(a.u0);
-    double error = std::numeric_limits<double>::quiet_NaN();
+    Real error = std::numeric_limits<Real>::quiet_NaN();
     try {
       integrate(a.bind(h), y, n, {}, a.reformulation->repreparation());
       const Vector x = a.model->to_physical(a.reformulation->read_back(y, step_time(n, h)));
@@ -354,9 +354,12 @@ std::vector<double> ModelChecks::errors(const SchemeEntry& scheme, double eps, c
 
 namespace {
 
-std::vector<double> step_sizes(const std::vector<long>& steps) {
-  std::vector<double> h;
-  for (const long n : steps) h.push_back(t_end / static_cast<double>(n));
+// Errors and step sizes as doubles for the order fits (logarithms: double is ample).
+std::vector<double> doubles(const std::vector<Real>& values) { return {values.begin(), values.end()}; }
+
+std::vector<Real> step_sizes(const std::vector<long>& steps) {
+  std::vector<Real> h;
+  for (const long n : steps) h.push_back(t_end / static_cast<Real>(n));
   return h;
 }
 
@@ -366,14 +369,14 @@ std::string step_range(const std::vector<long>& steps) {
 
 }  // namespace
 
-double ModelChecks::field_stiffness(double eps) const {
+Real ModelChecks::field_stiffness(Real eps) const {
   const auto m = model(eps);
   const Vector u0 = m->initial_value();
   Vector z = sample_state(*m, Vector::Zero(m->dim()), 0.7);
-  double rate = 0.0;
+  Real rate = 0.0;
   Matrix out(m->dim(), 1);
   for (int k = 0; k < 30; ++k) {  // the growth of z under J Hess H1(u0): its largest eigenvalue's modulus
-    const double norm = z.norm();
+    const Real norm = z.norm();
     if (!(norm > 0.0)) return 0.0;
     z /= norm;
     m->nonlinear_field_derivative(u0, z, out);
@@ -383,10 +386,10 @@ double ModelChecks::field_stiffness(double eps) const {
   return rate;
 }
 
-std::string ModelChecks::diagnose(const SchemeEntry& scheme, double eps, const Vector& x_ref) const {
+std::string ModelChecks::diagnose(const SchemeEntry& scheme, Real eps, const Vector& x_ref) const {
   std::vector<std::string> causes;
-  const double coarsest = t_end / static_cast<double>(options_.steps.front());
-  const double stiffness = field_stiffness(eps);
+  const Real coarsest = t_end / static_cast<Real>(options_.steps.front());
+  const Real stiffness = field_stiffness(eps);
   if (coarsest * stiffness > 1.0)
     causes.push_back(fmt::format(
         "measured: J Hess H1 at u0 has size {:.3g}, so h = {:g} times it is {:.2g}: the nonlinear part is "
@@ -394,8 +397,8 @@ std::string ModelChecks::diagnose(const SchemeEntry& scheme, double eps, const V
         "hand it over as Model::linear_remainder (docs/writing-a-model.md) so that it is integrated exactly",
         stiffness, coarsest, coarsest * stiffness, stiffness, 2.0 / stiffness));
   const std::vector<long> finest = {options_.steps.back()};
-  const double plain = errors(scheme, eps, x_ref, finest).front();
-  const double doubled = errors(scheme, eps, x_ref, finest, 2).front();
+  const Real plain = errors(scheme, eps, x_ref, finest).front();
+  const Real doubled = errors(scheme, eps, x_ref, finest, 2).front();
   if (std::isfinite(plain) && std::isfinite(doubled) && std::abs(plain - doubled) > 0.25 * std::abs(doubled))
     causes.push_back(fmt::format(
         "measured: doubling n_tau moves the error at h = 1/{} from {:.2e} to {:.2e}: the tau grid does not "
@@ -405,7 +408,7 @@ std::string ModelChecks::diagnose(const SchemeEntry& scheme, double eps, const V
   const int data = traits_of(scheme).initial_data_order;
   const int more = std::max(data, options_.reformulation_params.value("initial_data_order", 0)) + 1;
   if (more <= 8) {
-    const double richer = errors(scheme, eps, x_ref, finest, 1, more).front();
+    const Real richer = errors(scheme, eps, x_ref, finest, 1, more).front();
     if (std::isfinite(plain) && std::isfinite(richer) && std::abs(plain - richer) > 0.5 * std::abs(richer))
       causes.push_back(fmt::format(
           "measured: prepared data of order {} move the error at h = 1/{} from {:.2e} to {:.2e}: the data's "
@@ -418,44 +421,44 @@ std::string ModelChecks::diagnose(const SchemeEntry& scheme, double eps, const V
   return out;
 }
 
-void ModelChecks::orders(const SchemeEntry& scheme, double eps, const std::vector<double>& errs) {
+void ModelChecks::orders(const SchemeEntry& scheme, Real eps, const std::vector<Real>& errs) {
   // One eps: its errors and observed order, for information; the verdict is the envelope's.
-  const OrderFit fit = fit_order(step_sizes(options_.steps), errs, reference_floor(eps, fit_floor(traits_of(scheme))));
+  const OrderFit fit = fit_order(doubles(step_sizes(options_.steps)), doubles(errs), to_double(reference_floor(eps, fit_floor(traits_of(scheme)))));
   std::string row;
-  for (const double e : errs) row += fmt::format(" {:>9.2e}", e);
+  for (const Real e : errs) row += fmt::format(" {:>9.2e}", e);
   const std::string observed = !fit.finite ? "inf" : fit.measurable ? fmt::format("{:.2f}", fit.order) : "-";
   const std::string resonant = resonant_steps(options_.steps, eps, 2.0);
   fmt::print(out_, "    {:<5} {:<12} {:<10.4g}{} {:>6}{}\n", "", scheme.info.name, eps, row, observed,
              resonant.empty() ? "" : fmt::format("  ({} pi eps or 2 pi eps)", resonant));
 }
 
-void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<double>& sample,
-                           const std::map<double, Vector>& references) {
+void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& sample,
+                           const std::map<Real, Vector>& references) {
   // Uniform order q: the maximum of the error over eps is at most C h^q. At one eps the error
   // may dip below that bound or rise in a step-size resonance, so the order is judged on the
   // maximum over the dense sample (resonances inside it), fitted above the references' floors.
   // Schemes that lose order at resonances declare it (resonant_order): the bound is theirs.
   const StepperTraits traits = traits_of(scheme);
   const int q = traits.order_with_resonances();
-  const double margin = q > 2 ? high_order_margin : order_margin;
+  const Real margin = q > 2 ? high_order_margin : order_margin;
   const int factor = tau_factor(traits);
-  const double base_floor = fit_floor(traits);
+  const Real base_floor = fit_floor(traits);
   struct Envelope {
-    std::vector<double> worst;
-    std::vector<double> at;  // the eps of each maximum
-    double largest_floor = 0.0;
+    std::vector<Real> worst;
+    std::vector<Real> at;  // the eps of each maximum
+    Real largest_floor = 0.0;
   };
   const auto envelope_over = [&](const std::vector<long>& steps) {
-    Envelope env{std::vector<double>(steps.size(), 0.0), std::vector<double>(steps.size(), 0.0), 0.0};
-    for (const double eps : sample) {
-      const std::vector<double> errs =
+    Envelope env{std::vector<Real>(steps.size(), 0.0), std::vector<Real>(steps.size(), 0.0), 0.0};
+    for (const Real eps : sample) {
+      const std::vector<Real> errs =
           steps == options_.steps ? errors_at(scheme, eps, references.at(eps))
                                   : errors(scheme, eps, references.at(eps), steps, factor);
-      const double floor = reference_floor(eps, base_floor);
+      const Real floor = reference_floor(eps, base_floor);
       env.largest_floor = std::max(env.largest_floor, floor);
       for (size_t i = 0; i < steps.size(); ++i) {
         // An error below its own reference's accuracy measures that reference: left out.
-        const double e = !std::isfinite(errs[i]) ? std::numeric_limits<double>::infinity()
+        const Real e = !std::isfinite(errs[i]) ? std::numeric_limits<Real>::infinity()
                                                  : (errs[i] > floor ? errs[i] : 0.0);
         if (e > env.worst[i] || (std::isinf(e) && !std::isinf(env.worst[i]))) {
           env.worst[i] = e;
@@ -466,9 +469,9 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<double>&
     return env;
   };
   const Envelope env = envelope_over(options_.steps);
-  const OrderFit fit = fit_order(step_sizes(options_.steps), env.worst, base_floor);
+  const OrderFit fit = fit_order(doubles(step_sizes(options_.steps)), doubles(env.worst), to_double(base_floor));
   std::string row;
-  for (const double e : env.worst) row += e > 0.0 ? fmt::format(" {:>9.2e}", e) : fmt::format(" {:>9}", "(ref)");
+  for (const Real e : env.worst) row += e > 0.0 ? fmt::format(" {:>9.2e}", e) : fmt::format(" {:>9}", "(ref)");
   const std::string observed = !fit.finite ? "inf" : fit.measurable ? fmt::format("{:.2f}", fit.order) : "-";
   std::string declared = fmt::format(">= {} - {:g}", q, margin);
   if (q < traits.order)
@@ -504,14 +507,14 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<double>&
     // The steps may be pre-asymptotic for this model: if the maximum over steps four times
     // finer falls at the order, that fit counts.
     const Envelope fine = envelope_over(finer_steps_);
-    finer = fit_order(step_sizes(finer_steps_), fine.worst, base_floor);
+    finer = fit_order(doubles(step_sizes(finer_steps_)), doubles(fine.worst), to_double(base_floor));
     ok = finer.finite && finer.measurable && finer.order >= q - margin;
     if (finer.measurable) note = fmt::format("  ({:.2f} over {})", finer.order, step_range(finer_steps_));
   }
   std::string hint;
   if (!ok) {
     // Diagnose at the eps that set the maximum at the finest step.
-    const double eps = env.at.back() > 0.0 ? env.at.back() : sample.front();
+    const Real eps = env.at.back() > 0.0 ? env.at.back() : sample.front();
     hint = diagnose(scheme, eps, references.at(eps));
     if (hint.empty())
       hint = fit.finite ? "nothing measured stands out (the field is not stiff at u0 and n_tau resolves tau): the "
@@ -529,19 +532,19 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<double>&
          hint);
 }
 
-void ModelChecks::symmetry(const SchemeEntry& scheme, double eps) {
+void ModelChecks::symmetry(const SchemeEntry& scheme, Real eps) {
   Assembly a = assembly(scheme, "two-scale", eps, 1e-14, 1000);
   const Vector start = a.reformulation->prepare(a.u0);
   Vector y = start;
   a.bind(symmetry_step).step(0.0, y);
   a.bind(-symmetry_step).step(symmetry_step, y);
-  const double back = max_norm(y - start) / max_norm(start);
+  const Real back = max_norm(y - start) / max_norm(start);
   check(fmt::format("{:<8} eps = {:g}: returns to", scheme.info.name, eps), back, symmetry_limit,
         "a symmetric scheme's step h then -h returns the state; if the model is smooth this points at "
         "the scheme");
 }
 
-std::vector<double> ModelChecks::errors_at(const SchemeEntry& scheme, double eps, const Vector& x_ref) {
+std::vector<Real> ModelChecks::errors_at(const SchemeEntry& scheme, Real eps, const Vector& x_ref) {
   const auto key = std::make_pair(scheme.info.name, eps);
   auto it = errors_.find(key);
   if (it == errors_.end()) {
@@ -551,35 +554,35 @@ std::vector<double> ModelChecks::errors_at(const SchemeEntry& scheme, double eps
   return it->second;
 }
 
-std::vector<double> eps_sample(const std::vector<double>& epsilons, const std::vector<long>& steps, bool dense) {
-  std::vector<double> out = epsilons;
+std::vector<Real> eps_sample(const std::vector<Real>& epsilons, const std::vector<long>& steps, bool dense) {
+  std::vector<Real> out = epsilons;
   const auto [lo, hi] = std::minmax_element(epsilons.begin(), epsilons.end());
   if (dense && *hi > *lo) {
     // 32 log-spaced over the range, and the step-size resonances h = k pi eps (k = 1, 2) of
     // every step inside it: the maximum over eps then contains each step's worst case.
     for (int j = 0; j < dense_eps_points; ++j)
-      out.push_back(*lo * std::pow(*hi / *lo, static_cast<double>(j) / (dense_eps_points - 1)));
+      out.push_back(*lo * std::pow(*hi / *lo, static_cast<Real>(j) / (dense_eps_points - 1)));
     for (const long n : steps)
       for (int k = 1; k <= 2; ++k) {
-        const double eps = t_end / static_cast<double>(n) / (k * std::numbers::pi);
+        const Real eps = t_end / static_cast<Real>(n) / (k * std::numbers::pi);
         if (eps > *lo && eps < *hi) out.push_back(eps);
       }
   }
   std::sort(out.begin(), out.end(), std::greater<>());
   // Equal eps once (to a relative 1e-9: the given ones and the log grid's ends coincide).
-  std::vector<double> unique;
-  for (const double e : out)
+  std::vector<Real> unique;
+  for (const Real e : out)
     if (unique.empty() || std::abs(unique.back() - e) > 1e-9 * e) unique.push_back(e);
   return unique;
 }
 
 void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
-                              const std::vector<double>& epsilons) {
-  const std::vector<double> sample = eps_sample(epsilons, options_.steps, options_.dense_eps_sample);
-  std::map<double, Vector> references;
+                              const std::vector<Real>& epsilons) {
+  const std::vector<Real> sample = eps_sample(epsilons, options_.steps, options_.dense_eps_sample);
+  std::map<Real, Vector> references;
   fmt::print(out_, "\n  reference: rk78 on the filtered problem, tol {:g} (its accuracy: the change from tol {:g}), T = {:g}\n",
              reference_tol, 10.0 * reference_tol, t_end);
-  for (const double eps : sample) {
+  for (const Real eps : sample) {
     const auto m = model(eps);
     const Vector u0 = m->initial_value();
     const Vector u = reference(m, u0);
@@ -589,13 +592,13 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
     // the state in model variables once per step does to the physical error over the finest
     // run's steps (the charged particle at eps = 1e-6: v = (p + B q) / (2 eps) makes one ulp of
     // p 5e-11 of v, and 512 steps of it reach 1e-9).
-    const double rounding = m->rounding_floor(u) * static_cast<double>(options_.steps.back());
-    reference_accuracy_[eps] = std::max((coarser - references[eps]).norm() / references[eps].norm(), rounding);
+    const Real rounding = m->rounding_floor(u) * static_cast<Real>(options_.steps.back());
+    reference_accuracy_[eps] = std::max<Real>((coarser - references[eps]).norm() / references[eps].norm(), rounding);
     if (!m->has_hamiltonian_structure() || std::find(epsilons.begin(), epsilons.end(), eps) == epsilons.end())
       continue;  // no energy to conserve (said in the interface checks), or an eps of the dense sample only
-    const double h0 = m->energy(u0);
+    const Real h0 = m->energy(u0);
     check(fmt::format("energy H conserved at eps = {:g}", eps),
-          std::abs(m->energy(u) - h0) / std::max(std::abs(h0), 1e-300), 1e-6,
+          std::abs(m->energy(u) - h0) / std::max<Real>(std::abs(h0), 1e-300), 1e-6,
           "the exact flow conserves H = <Mu, u>/(2 eps) + H1(u): nonlinear_field must be J grad H1 of the "
           "model's H1, with the M and J of linear_flow");
   }
@@ -621,7 +624,7 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
   fmt::print(out_, " {:>6}  {}\n", "order", "expected");
   for (const auto* scheme : schemes) {
     try {
-      for (const double eps : epsilons) orders(*scheme, eps, errors_at(*scheme, eps, references.at(eps)));
+      for (const Real eps : epsilons) orders(*scheme, eps, errors_at(*scheme, eps, references.at(eps)));
       envelope(*scheme, sample, references);
     } catch (const std::exception& e) {
       report(false, fmt::format("{:<12} {:<10} {}", scheme->info.name, "max", e.what()),
@@ -636,7 +639,7 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
                  fmt::format("symmetry: a step h = {:g}, then -h (symmetric schemes)", symmetry_step),
                  "value", "limit");
     any_symmetric = true;
-    for (const double eps : epsilons) {
+    for (const Real eps : epsilons) {
       try {
         symmetry(*scheme, eps);
       } catch (const std::exception& e) {
@@ -684,7 +687,7 @@ ModelCheckReport check_model(const Registry& registry, const ModelEntry& entry,
                model_options.model_params.empty() ? std::string()
                                                   : ", model parameters " + model_options.model_params.dump());
     checks.interface(model_options.epsilons.front());
-    checks.convergence(schemes, model_options.epsilons);
+    checks.convergence(schemes, std::vector<Real>(model_options.epsilons.begin(), model_options.epsilons.end()));
   } catch (const std::exception& e) {
     checks.fail(e.what());
   }

@@ -411,8 +411,8 @@ void write_npy(const std::string& path, std::span<const Complex> values, const s
   write_atomically(path, npy_header("<c16", checked_shape(path, count, shape)), count, 16,
                    [&](std::uint64_t first, std::size_t n, unsigned char* out) {
                      for (std::size_t k = 0; k < n; ++k) {
-                       to_little(values[first + k].real(), out + 16 * k);
-                       to_little(values[first + k].imag(), out + 16 * k + 8);
+                       to_little(to_double(values[first + k].real()), out + 16 * k);
+                       to_little(to_double(values[first + k].imag()), out + 16 * k + 8);
                      }
                    });
 }
@@ -424,7 +424,7 @@ void write_npy(const std::string& path, const Vector& values, bool complex_value
   const std::uint64_t count = all.size();
   write_atomically(path, npy_header("<f8", checked_shape(path, count, shape)), count, 8,
                    [&](std::uint64_t first, std::size_t n, unsigned char* out) {
-                     for (std::size_t k = 0; k < n; ++k) to_little(all[first + k].real(), out + 8 * k);
+                     for (std::size_t k = 0; k < n; ++k) to_little(to_double(all[first + k].real()), out + 8 * k);
                    });
 }
 

@@ -9,15 +9,15 @@
 namespace tsi {
 namespace {
 
-// Below this modulus the Taylor series is used: 1/(k+2)! < 2^-53 for k >= 17, and the
+// Below this modulus the Taylor series is used: 1/(k+2)! < 2^-64 for k >= 19, and the
 // terms fall at least geometrically, so 24 terms leave the sum exact to rounding.
-constexpr double series_radius = 1.0;
+constexpr Real series_radius = 1.0;
 constexpr int series_terms = 24;
 
 // 1/n! for n = 0 .. series_terms + 2, each from the previous by one division.
-const std::array<double, series_terms + 3>& inverse_factorials() {
+const std::array<Real, series_terms + 3>& inverse_factorials() {
   static const auto table = [] {
-    std::array<double, series_terms + 3> t{};
+    std::array<Real, series_terms + 3> t{};
     t[0] = 1.0;
     for (int n = 1; n < static_cast<int>(t.size()); ++n) t[n] = t[n - 1] / n;
     return t;
@@ -37,8 +37,8 @@ Complex series(Complex z, int shift) {
 
 Complex expm1(Complex z) {
   // Re(e^z - 1) = expm1(x) cos y - 2 sin^2(y/2); Im = e^x sin y: no cancellation near 0.
-  const double x = z.real(), y = z.imag();
-  const double s = std::sin(0.5 * y);
+  const Real x = z.real(), y = z.imag();
+  const Real s = std::sin(0.5 * y);
   return {std::expm1(x) * std::cos(y) - 2.0 * s * s, std::exp(x) * std::sin(y)};
 }
 
@@ -55,13 +55,13 @@ Complex phi2(Complex z) {
 Complex phi(int k, Complex z) {
   if (k < 0 || k > 20) throw std::invalid_argument("tsi::phi: k = " + std::to_string(k) + ", expected 0 to 20");
   if (k == 0) return std::exp(z);
-  const double r = std::abs(z);
-  if (r <= std::max(1.0, static_cast<double>(k))) {
+  const Real r = std::abs(z);
+  if (r <= std::max(Real(1), static_cast<Real>(k))) {
     // Terms |z|^m / (m + k)! with |z| <= k fall below 2^-60 of the first within 60 terms
     // (at k = 20: 20^60 / 80! ~ 1e-41); the sum of their moduli is within a factor 10 of
     // |phi_k| there, so no digits cancel.
     constexpr int terms = 64;
-    double inv = 1.0;  // 1 / (terms + k)!
+    Real inv = 1.0;  // 1 / (terms + k)!
     for (int n = 2; n <= terms + k; ++n) inv /= n;
     Complex sum = 0.0;
     for (int m = terms; m >= 0; --m) {
@@ -71,7 +71,7 @@ Complex phi(int k, Complex z) {
     return sum;
   }
   Complex value = phi1(z);
-  double inv_factorial = 1.0;  // 1/j!
+  Real inv_factorial = 1.0;  // 1/j!
   for (int j = 1; j < k; ++j) {
     inv_factorial /= j;
     value = (value - inv_factorial) / z;

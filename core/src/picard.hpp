@@ -11,7 +11,7 @@ class PicardSolver final : public FixedPointSolver {
   double state_vectors() const override { return 1.0; }
 
  protected:
-  int iterate(Vector& x, FixedPointMap g, double& increment) override {
+  int iterate(Vector& x, FixedPointMap g, Real& increment) override {
     next_.resize(x.size());
     for (int k = 1; k <= options().max_iter; ++k) {
       g(x, next_);

@@ -9,11 +9,11 @@ const Vector& Problem::remainder_multipliers() const {
   return none;
 }
 
-void Problem::linear_flow(double /*h*/, Vector& /*y*/) {
+void Problem::linear_flow(Real /*h*/, Vector& /*y*/) {
   throw Error("this problem has no exact linear flow (has_exact_flows() is false)");
 }
 
-void Problem::nonlinear_flow(double /*t*/, double /*h*/, Vector& /*y*/) {
+void Problem::nonlinear_flow(Real /*t*/, Real /*h*/, Vector& /*y*/) {
   throw Error("this problem has no exact nonlinear flow (has_exact_flows() is false)");
 }
 

@@ -1,6 +1,5 @@
 #include "tsi/spectral_grid.hpp"
 
-#include <fftw3.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -8,6 +7,7 @@
 #include <limits>
 
 #include "fftw_planner.hpp"
+#include "fftw_precision.hpp"
 #include "tsi/error.hpp"
 #include "tsi/fft.hpp"
 #include "tsi/phase.hpp"
@@ -76,9 +76,9 @@ SpectralGrid::SpectralGrid(std::vector<int> shape) : shape_(std::move(shape)) {
   for (int a = 0; a < n1; ++a)
     for (int b = 0; b < n2; ++b)
       for (int c = 0; c < n3; ++c, ++p) {
-        const double m1 = folded_[0][static_cast<std::size_t>(a)];
-        const double m2 = dims() > 1 ? folded_[1][static_cast<std::size_t>(b)] : 0.0;
-        const double m3 = dims() > 2 ? folded_[2][static_cast<std::size_t>(c)] : 0.0;
+        const Real m1 = folded_[0][static_cast<std::size_t>(a)];
+        const Real m2 = dims() > 1 ? folded_[1][static_cast<std::size_t>(b)] : 0.0;
+        const Real m3 = dims() > 2 ? folded_[2][static_cast<std::size_t>(c)] : 0.0;
         laplacian_(p) = m1 * m1 + m2 * m2 + m3 * m3;
       }
 }
@@ -88,8 +88,8 @@ int SpectralGrid::wave_number(int direction, int j) const {
   return 2 * j < n ? j : j - n;
 }
 
-double SpectralGrid::max_laplacian_symbol() const {
-  double sum = 0.0;
+Real SpectralGrid::max_laplacian_symbol() const {
+  Real sum = 0;
   for (const int n : shape_) sum += 0.25 * n * n;
   return sum;
 }
@@ -109,8 +109,8 @@ RealVector SpectralGrid::dealias_mask() const {
   return mask;
 }
 
-double SpectralGrid::coordinate(int direction, int j) const {
-  return two_pi * static_cast<double>(j) / shape_[static_cast<std::size_t>(direction)];
+Real SpectralGrid::coordinate(int direction, int j) const {
+  return two_pi * static_cast<Real>(j) / shape_[static_cast<std::size_t>(direction)];
 }
 
 std::string SpectralGrid::describe() const {
@@ -172,30 +172,30 @@ GridTransforms::GridTransforms(const SpectralGrid& grid, Index columns, ThreadLi
   if (detail::LeadingDirections::used_for(grid))  // by direction; the last one by the plans below
     leading_ = std::make_unique<detail::LeadingDirections>(shape, shape.back());
   std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
-  buffer_ = reinterpret_cast<Complex*>(fftw_alloc_complex(values));
+  buffer_ = reinterpret_cast<Complex*>(TSI_FFTW(alloc_complex)(values));
   if (!buffer_)
     throw Error(fmt::format("GridTransforms: cannot allocate {} x {} complex values ({:.3g} GB)", grid.describe(),
-                            columns, 16.0 * static_cast<double>(values) / 1e9));
+                            columns, static_cast<double>(sizeof(Complex)) * static_cast<double>(values) / 1e9));
   if (detail::fftw_threads_ready())
-    fftw_plan_with_nthreads(leading_ ? 1 : fftw_threads.for_size(static_cast<Index>(values)));
-  auto* data = reinterpret_cast<fftw_complex*>(buffer_);
+    TSI_FFTW(plan_with_nthreads)(leading_ ? 1 : fftw_threads.for_size(static_cast<Index>(values)));
+  auto* data = reinterpret_cast<TSI_FFTW(complex)*>(buffer_);
   const int signs[2] = {FFTW_FORWARD, FFTW_BACKWARD};
   for (int d = 0; d < 2; ++d) {
     if (leading_) {  // the last direction of one field: points / n_last rows of n_last
       const int n_last = shape.back();
-      plans_[d] = fftw_plan_many_dft(1, &n_last, static_cast<int>(points_ / n_last), data, nullptr, 1, n_last, data,
+      plans_[d] = TSI_FFTW(plan_many_dft)(1, &n_last, static_cast<int>(points_ / n_last), data, nullptr, 1, n_last, data,
                                      nullptr, 1, n_last, signs[d], FFTW_ESTIMATE);
     } else {
       const int dist = static_cast<int>(points_);  // checked against int by SpectralGrid
-      plans_[d] = fftw_plan_many_dft(grid.dims(), shape.data(), static_cast<int>(columns_), data, nullptr, 1, dist,
+      plans_[d] = TSI_FFTW(plan_many_dft)(grid.dims(), shape.data(), static_cast<int>(columns_), data, nullptr, 1, dist,
                                      data, nullptr, 1, dist, signs[d], FFTW_ESTIMATE);
     }
   }
-  if (detail::fftw_threads_ready()) fftw_plan_with_nthreads(1);
+  if (detail::fftw_threads_ready()) TSI_FFTW(plan_with_nthreads)(1);
   if (!plans_[0] || !plans_[1]) {
     for (void* plan : plans_)
-      if (plan) fftw_destroy_plan(static_cast<fftw_plan>(plan));
-    fftw_free(buffer_);
+      if (plan) TSI_FFTW(destroy_plan)(static_cast<TSI_FFTW(plan)>(plan));
+    TSI_FFTW(free)(buffer_);
     throw Error(fmt::format("GridTransforms: FFTW could not plan {} x {} transforms", grid.describe(), columns));
   }
   std::fill(buffer_, buffer_ + values, Complex(0.0));
@@ -205,17 +205,17 @@ GridTransforms::~GridTransforms() {
   leading_.reset();  // before the lock: FftBatch takes it itself
   std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
   for (void* plan : plans_)
-    if (plan) fftw_destroy_plan(static_cast<fftw_plan>(plan));
-  fftw_free(buffer_);
+    if (plan) TSI_FFTW(destroy_plan)(static_cast<TSI_FFTW(plan)>(plan));
+  TSI_FFTW(free)(buffer_);
 }
 
 void GridTransforms::execute(int direction) {
-  auto* plan = static_cast<fftw_plan>(plans_[direction]);
-  if (!leading_) return fftw_execute(plan);
+  auto* plan = static_cast<TSI_FFTW(plan)>(plans_[direction]);
+  if (!leading_) return TSI_FFTW(execute)(plan);
   // Every column has the buffer's alignment (points_ even, 16-byte complex values).
   for (Index j = 0; j < columns_; ++j) {
     Complex* field = buffer_ + j * points_;
-    fftw_execute_dft(plan, reinterpret_cast<fftw_complex*>(field), reinterpret_cast<fftw_complex*>(field));
+    TSI_FFTW(execute_dft)(plan, reinterpret_cast<TSI_FFTW(complex)*>(field), reinterpret_cast<TSI_FFTW(complex)*>(field));
     leading_->transform(field, direction);
   }
 }
@@ -239,36 +239,36 @@ RealGridTransforms::RealGridTransforms(const SpectralGrid& grid, Index columns, 
   const auto n_values = static_cast<std::size_t>(points_) * static_cast<std::size_t>(columns_);
   const auto n_coefficients = static_cast<std::size_t>(half_points_) * static_cast<std::size_t>(columns_);
   std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
-  values_ = fftw_alloc_real(n_values);
-  spectrum_ = reinterpret_cast<Complex*>(fftw_alloc_complex(n_coefficients));
+  values_ = TSI_FFTW(alloc_real)(n_values);
+  spectrum_ = reinterpret_cast<Complex*>(TSI_FFTW(alloc_complex)(n_coefficients));
   const auto release = [this] {
     for (void* plan : plans_)
-      if (plan) fftw_destroy_plan(static_cast<fftw_plan>(plan));
-    if (values_) fftw_free(values_);
-    if (spectrum_) fftw_free(spectrum_);
+      if (plan) TSI_FFTW(destroy_plan)(static_cast<TSI_FFTW(plan)>(plan));
+    if (values_) TSI_FFTW(free)(values_);
+    if (spectrum_) TSI_FFTW(free)(spectrum_);
   };
   if (!values_ || !spectrum_) {
     release();
     throw Error(fmt::format("RealGridTransforms: cannot allocate {} x {} real values ({:.3g} GB)", grid.describe(),
-                            columns, 16.0 * static_cast<double>(n_values) / 1e9));
+                            columns, static_cast<double>(sizeof(Complex)) * static_cast<double>(n_values) / 1e9));
   }
   if (detail::fftw_threads_ready())
-    fftw_plan_with_nthreads(leading_ ? 1 : fftw_threads.for_size(static_cast<Index>(n_values)));
-  auto* out = reinterpret_cast<fftw_complex*>(spectrum_);
+    TSI_FFTW(plan_with_nthreads)(leading_ ? 1 : fftw_threads.for_size(static_cast<Index>(n_values)));
+  auto* out = reinterpret_cast<TSI_FFTW(complex)*>(spectrum_);
   if (leading_) {  // the last direction of one field: its rows
     const int rows = static_cast<int>(points_ / n_last_);
-    plans_[0] = fftw_plan_many_dft_r2c(1, &n_last_, rows, values_, nullptr, 1, n_last_, out, nullptr, 1, half,
+    plans_[0] = TSI_FFTW(plan_many_dft_r2c)(1, &n_last_, rows, values_, nullptr, 1, n_last_, out, nullptr, 1, half,
                                        FFTW_ESTIMATE);
-    plans_[1] = fftw_plan_many_dft_c2r(1, &n_last_, rows, out, nullptr, 1, half, values_, nullptr, 1, n_last_,
+    plans_[1] = TSI_FFTW(plan_many_dft_c2r)(1, &n_last_, rows, out, nullptr, 1, half, values_, nullptr, 1, n_last_,
                                        FFTW_ESTIMATE);
   } else {
     const int dist_values = static_cast<int>(points_), dist_spectrum = static_cast<int>(half_points_);
-    plans_[0] = fftw_plan_many_dft_r2c(grid.dims(), shape.data(), static_cast<int>(columns_), values_, nullptr, 1,
+    plans_[0] = TSI_FFTW(plan_many_dft_r2c)(grid.dims(), shape.data(), static_cast<int>(columns_), values_, nullptr, 1,
                                        dist_values, out, nullptr, 1, dist_spectrum, FFTW_ESTIMATE);
-    plans_[1] = fftw_plan_many_dft_c2r(grid.dims(), shape.data(), static_cast<int>(columns_), out, nullptr, 1,
+    plans_[1] = TSI_FFTW(plan_many_dft_c2r)(grid.dims(), shape.data(), static_cast<int>(columns_), out, nullptr, 1,
                                        dist_spectrum, values_, nullptr, 1, dist_values, FFTW_ESTIMATE);
   }
-  if (detail::fftw_threads_ready()) fftw_plan_with_nthreads(1);
+  if (detail::fftw_threads_ready()) TSI_FFTW(plan_with_nthreads)(1);
   if (!plans_[0] || !plans_[1]) {
     release();
     throw Error(fmt::format("RealGridTransforms: FFTW could not plan {} x {} transforms", grid.describe(), columns));
@@ -281,29 +281,29 @@ RealGridTransforms::~RealGridTransforms() {
   leading_.reset();  // before the lock: FftBatch takes it itself
   std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
   for (void* plan : plans_)
-    if (plan) fftw_destroy_plan(static_cast<fftw_plan>(plan));
-  fftw_free(values_);
-  fftw_free(spectrum_);
+    if (plan) TSI_FFTW(destroy_plan)(static_cast<TSI_FFTW(plan)>(plan));
+  TSI_FFTW(free)(values_);
+  TSI_FFTW(free)(spectrum_);
 }
 
 void RealGridTransforms::forward() {
-  auto* plan = static_cast<fftw_plan>(plans_[0]);
-  if (!leading_) return fftw_execute(plan);
+  auto* plan = static_cast<TSI_FFTW(plan)>(plans_[0]);
+  if (!leading_) return TSI_FFTW(execute)(plan);
   for (Index j = 0; j < columns_; ++j) {
     Complex* field = spectrum_ + j * half_points_;
     // Columns keep the buffers' alignment: points_ even (doubles) and 16-byte complex values.
-    fftw_execute_dft_r2c(plan, values_ + j * points_, reinterpret_cast<fftw_complex*>(field));
+    TSI_FFTW(execute_dft_r2c)(plan, values_ + j * points_, reinterpret_cast<TSI_FFTW(complex)*>(field));
     leading_->transform(field, 0);
   }
 }
 
 void RealGridTransforms::backward() {
-  auto* plan = static_cast<fftw_plan>(plans_[1]);
-  if (!leading_) return fftw_execute(plan);
+  auto* plan = static_cast<TSI_FFTW(plan)>(plans_[1]);
+  if (!leading_) return TSI_FFTW(execute)(plan);
   for (Index j = 0; j < columns_; ++j) {
     Complex* field = spectrum_ + j * half_points_;
     leading_->transform(field, 1);
-    fftw_execute_dft_c2r(plan, reinterpret_cast<fftw_complex*>(field), values_ + j * points_);
+    TSI_FFTW(execute_dft_c2r)(plan, reinterpret_cast<TSI_FFTW(complex)*>(field), values_ + j * points_);
   }
 }
 
@@ -337,14 +337,14 @@ ParamSchema spectral_grid_params(const std::string& what) {
       integer_param("n_z", nullptr, "grid points in z (dims = 3); default n_x").check(even_size, even)};
 }
 
-double PlaneWave::k2() const {
-  double sum = 0.0;
-  for (const int k : wave_vector) sum += static_cast<double>(k) * k;
+Real PlaneWave::k2() const {
+  Real sum = 0;
+  for (const int k : wave_vector) sum += static_cast<Real>(k) * k;
   return sum;
 }
 
-Complex PlaneWave::at(const std::array<double, 3>& x) const {
-  double phase = 0.0;
+Complex PlaneWave::at(const std::array<Real, 3>& x) const {
+  Real phase = 0;
   for (std::size_t i = 0; i < 3; ++i) phase += wave_vector[i] * x[i];
   return std::polar(amplitude, phase);
 }

@@ -97,7 +97,7 @@ TEST_CASE("loader: the layout handshake covers the exchanged structures") {
   CHECK(layout.address_sanitizer == 0u);
 #endif
   CHECK(layout.scheme.size == sizeof(tsi::Scheme));
-  CHECK(TSI_PLUGIN_ABI_VERSION == 16);  // 4: the remainder, bind_tau_grid, invariants; 5: entry completion, needs_exact_flows; 6: traits from parameters; 7: independent_tau_grid_bindings; 8: bound steppers; 9: real tau grids (TauGridField::evaluate_real), fields, Model::physical_dim, memory of a binding (Scheme::state_vectors, Diagonal, in_place); 10: the run context (Params::context, FftBatch threads); 11: exact solutions (Model::exact_solution, Field::affine_terms); 12: the narrow Model (capabilities: hamiltonian, fused_tau_grid, exact_nonlinear_flow, physical_variables); 13: PhysicalVariables::physical_shape; 14: re-preparation as a state observer (Reformulation::repreparation, no Problem::between_steps), the typed selection, VerificationRegime::params; 15: ModelInvariant::conserved (diagnostics); 16: Context::collective (runs split over processes), Model::split_across_processes and canonicalize_physical
+  CHECK(TSI_PLUGIN_ABI_VERSION == 17);  // 4: the remainder, bind_tau_grid, invariants; 5: entry completion, needs_exact_flows; 6: traits from parameters; 7: independent_tau_grid_bindings; 8: bound steppers; 9: real tau grids (TauGridField::evaluate_real), fields, Model::physical_dim, memory of a binding (Scheme::state_vectors, Diagonal, in_place); 10: the run context (Params::context, FftBatch threads); 11: exact solutions (Model::exact_solution, Field::affine_terms); 12: the narrow Model (capabilities: hamiltonian, fused_tau_grid, exact_nonlinear_flow, physical_variables); 13: PhysicalVariables::physical_shape; 14: re-preparation as a state observer (Reformulation::repreparation, no Problem::between_steps), the typed selection, VerificationRegime::params; 15: ModelInvariant::conserved (diagnostics); 16: Context::collective (runs split over processes), Model::split_across_processes and canonicalize_physical; 17: tsi::Real (TSI_PRECISION) in the layout, Real times, step sizes and norms
 }
 
 TEST_CASE("loader: a plugin for another tsi major version is refused") {
@@ -145,7 +145,8 @@ TEST_CASE("loader: a directory scan collects failures without throwing") {
       {"broken_flow", true}, {"broken_fused", true},      {"duplicate", true},        {"general", true},
       {"good", false},
       {"no_entry", false},   {"shipped_duplicate", true}, {"stiff", true},           {"throws", false},
-      {"wrong_abi", false},  {"wrong_layout", false},     {"wrong_major", false},     {"wrong_sanitizer", false}};
+      {"wrong_abi", false},  {"wrong_layout", false},     {"wrong_major", false},     {"wrong_precision", false},
+      {"wrong_sanitizer", false}};
   REQUIRE(reports.size() == expected.size());
   for (std::size_t i = 0; i < reports.size(); ++i) {
     CAPTURE(reports[i].path);
@@ -179,6 +180,14 @@ TEST_CASE("loader: a path list loads files and collects failures") {
 
 TEST_CASE("loader: the default directory is known") {
   CHECK_FALSE(tsi::PluginLoader::default_directory().empty());
+}
+
+TEST_CASE("loader: a plugin built for another precision (TSI_PRECISION) is refused") {
+  tsi::Registry r;
+  tsi::PluginLoader loader(r);
+  CHECK_THROWS_WITH_AS(loader.load(fixture("wrong_precision")), doctest::Contains("built for another TSI_PRECISION"),
+                       tsi::PluginError);
+  CHECK(r.models().empty());
 }
 
 TEST_CASE("loader: a plugin built the other way round with respect to AddressSanitizer is refused") {

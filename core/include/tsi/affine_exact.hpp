@@ -19,7 +19,7 @@ inline constexpr Index max_affine_exact_dim = 32;
 /// difference to a second evaluation with 8 times the scaling, or the rounding of u(t) to
 /// double where that is larger. Refuses (tsi::Error) n > max_affine_exact_dim, t < 0 and sizes
 /// that do not match.
-TSI_API ExactSolution::Value affine_exact_solution(const Matrix& A, double eps, const AffineTerms& f,
-                                                   const Vector& u0, double t);
+TSI_API ExactSolution::Value affine_exact_solution(const Matrix& A, Real eps, const AffineTerms& f,
+                                                   const Vector& u0, Real t);
 
 }  // namespace tsi

@@ -25,12 +25,12 @@ inline void swap(Vector& a, Vector& b) { a.swap(b); }
 inline void set_zero(Index n, Vector& out) { out.setZero(n); }
 
 /// out = a x + b y (out may alias x or y).
-inline void axpby(double a, const Vector& x, double b, const Vector& y, Vector& out) {
+inline void axpby(Real a, const Vector& x, Real b, const Vector& y, Vector& out) {
   out = a * x + b * y;
 }
 
 /// y += a x.
-inline void axpy(double a, const Vector& x, Vector& y) {
+inline void axpy(Real a, const Vector& x, Vector& y) {
   y += a * x;
 }
 
@@ -159,7 +159,7 @@ inline void diagonal_linear_combination(const Vector* start, std::span<const Dia
     if (dj->run() != r) r = 0;
   if (r == 0) {  // runs that differ: entry by entry
     for (Index i = 0; i < n; ++i) {
-      Complex acc = start ? (*start)(i) : Complex(0.0);
+      Complex acc = start ? (*start)(i) : Complex(0);
       for (size_t j = 0; j < x.size(); ++j) acc += (*d[j])(i) * (*x[j])(i);
       out(i) = acc;
     }
@@ -201,23 +201,23 @@ using tsi::max_norm;
 /// The squares of max_i |next_i - x_i| and of max_i |next_i| into m[0] and m[1]: one pass over
 /// the doubles in two independent lanes, so the maxima stay in vector registers (std::max over
 /// complex norms in one chain ran at the latency of a compare: 30% of a charged-particle step).
-inline void increment_maxima(const Vector& next, const Vector& x, double m[2]) {
-  const double* pa = reinterpret_cast<const double*>(next.data());
-  const double* pb = reinterpret_cast<const double*>(x.data());
+inline void increment_maxima(const Vector& next, const Vector& x, Real m[2]) {
+  const Real* pa = reinterpret_cast<const Real*>(next.data());
+  const Real* pb = reinterpret_cast<const Real*>(x.data());
   const Index n = 2 * next.size();
-  double d[2] = {0.0, 0.0}, s[2] = {0.0, 0.0};
+  Real d[2] = {0, 0}, s[2] = {0, 0};
   Index i = 0;
   for (; i + 4 <= n; i += 4)
     for (int l = 0; l < 2; ++l) {
       const Index k = i + 2 * l;
-      const double dr = pa[k] - pb[k], di = pa[k + 1] - pb[k + 1];
-      const double dd = dr * dr + di * di;
-      const double ss = pa[k] * pa[k] + pa[k + 1] * pa[k + 1];
+      const Real dr = pa[k] - pb[k], di = pa[k + 1] - pb[k + 1];
+      const Real dd = dr * dr + di * di;
+      const Real ss = pa[k] * pa[k] + pa[k + 1] * pa[k + 1];
       d[l] = dd > d[l] ? dd : d[l];
       s[l] = ss > s[l] ? ss : s[l];
     }
   for (; i < n; i += 2) {
-    const double dr = pa[i] - pb[i], di = pa[i + 1] - pb[i + 1];
+    const Real dr = pa[i] - pb[i], di = pa[i + 1] - pb[i + 1];
     d[0] = std::max(d[0], dr * dr + di * di);
     s[0] = std::max(s[0], pa[i] * pa[i] + pa[i + 1] * pa[i + 1]);
   }
@@ -226,15 +226,15 @@ inline void increment_maxima(const Vector& next, const Vector& x, double m[2]) {
 }
 
 /// The relative increment from increment_maxima's squares (the denominator 1 when next is 0).
-inline double relative_increment(const double m[2]) {
-  const double scale = std::sqrt(m[1]);
-  return std::sqrt(m[0]) / (scale > 0.0 ? scale : 1.0);
+inline Real relative_increment(const Real m[2]) {
+  const Real scale = std::sqrt(m[1]);
+  return std::sqrt(m[0]) / (scale > 0 ? scale : Real(1));
 }
 
 /// max_i |next_i - x_i| / max_i |next_i| (the denominator 1 when next is 0): the fixed-point
 /// solvers' convergence test.
-inline double relative_increment(const Vector& next, const Vector& x) {
-  double m[2];
+inline Real relative_increment(const Vector& next, const Vector& x) {
+  Real m[2];
   increment_maxima(next, x, m);
   return relative_increment(m);
 }

@@ -39,7 +39,7 @@ struct TSI_API AssemblyOptions {
   /// Bind the scheme to this step size (0: not bound; Assembly::bind later). A run binds after
   /// it has prepared its data (0 here, then Assembly::bind): the preparation's temporaries are
   /// freed by then.
-  double h = 0.0;
+  Real h = 0;
   /// The memory a two-scale run may take, in bytes (0: what the machine has available now);
   /// a run whose footprint exceeds it is refused, naming its sizes, before it is built.
   double memory_bytes = 0.0;
@@ -69,7 +69,7 @@ struct TSI_API Assembly {
   Footprint footprint;  ///< what the run will hold at its peak (checked before the reformulation was built)
 
   /// Binds the scheme to the reformulation and step size h (replacing any earlier binding).
-  Stepper& bind(double h);
+  Stepper& bind(Real h);
 };
 
 /// Builds model, scheme and reformulation from a resolved selection (resolve_selection) and

@@ -17,9 +17,9 @@ class TSI_API Collective {
   virtual int rank() const = 0;
   virtual int size() const = 0;
   /// values[i] = the sum of values[i] over the processes (in place, the same result on all).
-  virtual void sum(double* values, Index n) const = 0;
+  virtual void sum(Real* values, Index n) const = 0;
   /// values[i] = the largest values[i] over the processes (in place).
-  virtual void max(double* values, Index n) const = 0;
+  virtual void max(Real* values, Index n) const = 0;
   /// The processes' `local` vectors one after the other, in rank order, on rank 0 (an empty
   /// vector elsewhere).
   virtual RealVector gather(const RealVector& local) const = 0;
@@ -28,13 +28,13 @@ class TSI_API Collective {
   [[noreturn]] virtual void abort(int code) const = 0;
 
   /// The sum of one number over the processes.
-  double sum(double value) const {
+  Real sum(Real value) const {
     sum(&value, 1);
     return value;
   }
   /// True when `flag` holds on every process.
   bool all(bool flag) const {
-    double v = flag ? 0.0 : 1.0;
+    Real v = flag ? 0 : 1;
     max(&v, 1);
     return v == 0.0;
   }

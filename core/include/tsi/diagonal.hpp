@@ -44,15 +44,15 @@ class Diagonal {
   }
   /// f at stored value b (averaged over its pair where it has one), of the operator scaled by `scale`.
   template <class F>
-  auto function_at(Index b, double scale, F&& f) const {
+  auto function_at(Index b, Real scale, F&& f) const {
     const Complex v = values_(b);
-    if (pairs_.size() == 0 || pairs_(b) == 0.0) return f(scale * v);
-    auto plus = f(scale * (v + Complex(0.0, pairs_(b))));
-    const auto minus = f(scale * (v - Complex(0.0, pairs_(b))));
+    if (pairs_.size() == 0 || pairs_(b) == 0) return f(scale * v);
+    auto plus = f(scale * (v + Complex(0, pairs_(b))));
+    const auto minus = f(scale * (v - Complex(0, pairs_(b))));
     if constexpr (std::is_same_v<std::decay_t<decltype(plus)>, Complex>) {
-      return Complex(0.5 * (plus + minus));
+      return Complex(Real(0.5) * (plus + minus));
     } else {
-      for (size_t j = 0; j < plus.size(); ++j) plus[j] = 0.5 * (plus[j] + minus[j]);
+      for (size_t j = 0; j < plus.size(); ++j) plus[j] = Real(0.5) * (plus[j] + minus[j]);
       return plus;
     }
   }
@@ -68,7 +68,7 @@ class Diagonal {
 /// out_i = f(scale * lambda_i): a function of the diagonal operator scale * L, evaluated
 /// once per step size by the exponential schemes (e^{hL}, h phi1(hL), ...), once per stored value.
 template <class F>
-void diagonal_function(const Diagonal& lambda, double scale, F&& f, Diagonal& out) {
+void diagonal_function(const Diagonal& lambda, Real scale, F&& f, Diagonal& out) {
   const Vector& v = lambda.values();
   Vector values(v.size());
   for (Index i = 0; i < v.size(); ++i) values(i) = lambda.function_at(i, scale, f);
@@ -77,7 +77,7 @@ void diagonal_function(const Diagonal& lambda, double scale, F&& f, Diagonal& ou
 
 /// The same with one value per unknown (a coefficient a scheme stores as a Vector).
 template <class F>
-void diagonal_function(const Diagonal& lambda, double scale, F&& f, Vector& out) {
+void diagonal_function(const Diagonal& lambda, Real scale, F&& f, Vector& out) {
   Diagonal d;
   diagonal_function(lambda, scale, std::forward<F>(f), d);
   out = d.expanded();
@@ -85,7 +85,7 @@ void diagonal_function(const Diagonal& lambda, double scale, F&& f, Vector& out)
 
 /// out_i = f(scale * lambda_i) for a Vector of the diagonal's entries.
 template <class F>
-void diagonal_function(const Vector& lambda, double scale, F&& f, Vector& out) {
+void diagonal_function(const Vector& lambda, Real scale, F&& f, Vector& out) {
   out.resize(lambda.size());
   for (Index i = 0; i < lambda.size(); ++i) out(i) = f(scale * lambda(i));
 }
@@ -93,7 +93,7 @@ void diagonal_function(const Vector& lambda, double scale, F&& f, Vector& out) {
 /// outs[j]_i = f(scale * lambda_i)[j] for a function with several values per point (the
 /// weights of an exponential multistep or collocation scheme), each out shaped like lambda.
 template <class F>
-void diagonal_functions(const Diagonal& lambda, double scale, F&& f, std::span<Diagonal* const> outs) {
+void diagonal_functions(const Diagonal& lambda, Real scale, F&& f, std::span<Diagonal* const> outs) {
   const Vector& v = lambda.values();
   std::vector<Vector> values(outs.size(), Vector(v.size()));
   for (Index i = 0; i < v.size(); ++i) {
@@ -105,7 +105,7 @@ void diagonal_functions(const Diagonal& lambda, double scale, F&& f, std::span<D
 
 /// The same for a Vector of the diagonal's entries, each out sized like lambda.
 template <class F>
-void diagonal_functions(const Vector& lambda, double scale, F&& f, std::span<Vector* const> outs) {
+void diagonal_functions(const Vector& lambda, Real scale, F&& f, std::span<Vector* const> outs) {
   for (Vector* out : outs) out->resize(lambda.size());
   for (Index i = 0; i < lambda.size(); ++i) {
     const auto values = f(scale * lambda(i));

@@ -14,14 +14,14 @@ namespace tsi {
 /// Adams-Bashforth uses the nodes 0, -1, .., -(r-1); exponential collocation the Gauss nodes.
 class TSI_API InterpolatoryWeights {
  public:
-  explicit InterpolatoryWeights(std::vector<double> nodes);
+  explicit InterpolatoryWeights(std::vector<Real> nodes);
   /// w_j(kappa, z) for j = 0 .. nodes - 1.
-  std::vector<Complex> operator()(double kappa, Complex z) const;
-  const std::vector<double>& nodes() const { return nodes_; }
+  std::vector<Complex> operator()(Real kappa, Complex z) const;
+  const std::vector<Real>& nodes() const { return nodes_; }
 
  private:
-  std::vector<double> nodes_;
-  std::vector<std::vector<double>> monomials_;  // [j][m]: coefficient of s^m in l_j(s)
+  std::vector<Real> nodes_;
+  std::vector<std::vector<Real>> monomials_;  // [j][m]: coefficient of s^m in l_j(s)
 };
 
 }  // namespace tsi

@@ -38,7 +38,7 @@ class TSI_API FftBatch {
   /// every result multiplied by `scale` on the way out (the same products as a pass after).
   /// With `part` (0 <= part < parts()) only that part's rows, through its own block: parts may
   /// be transformed at the same time on different threads.
-  void transform(const Complex* from, Complex* to, int direction, double scale = 1.0, const Complex* shift = nullptr,
+  void transform(const Complex* from, Complex* to, int direction, Real scale = 1, const Complex* shift = nullptr,
                  int part = -1);
   /// Values at tau_j = 2*pi*j/n -> Fourier coefficients (normalised by 1/n).
   void forward();

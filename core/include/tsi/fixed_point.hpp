@@ -52,9 +52,9 @@ class TSI_API FixedPointSolver {
 
  protected:
   /// One solve: returns the number of sweeps, or -1 when max_iter did not reach tol.
-  virtual int iterate(Vector& x, FixedPointMap g, double& increment) = 0;
+  virtual int iterate(Vector& x, FixedPointMap g, Real& increment) = 0;
   /// The relative increment from x to next, over every process of a split state.
-  double increment(const Vector& next, const Vector& x) const;
+  Real increment(const Vector& next, const Vector& x) const;
 
  private:
   FixedPointOptions options_;

@@ -35,17 +35,17 @@ class TSI_API PeriodicMatrixFlow {
   Index dim() const { return A_.rows(); }
   const Matrix& A() const { return A_; }
   /// e^{A tau}; real (imaginary parts exactly 0) when A is.
-  Matrix at(double tau) const;
+  Matrix at(Real tau) const;
   /// max |k| over the eigenvalues i k of A.
   long max_frequency() const { return max_frequency_; }
   /// The largest entry of e^{2 pi A} - I (what the period check measured).
-  double period_deviation() const { return deviation_; }
+  Real period_deviation() const { return deviation_; }
 
  private:
   Matrix A_;
   bool real_ = true;
   long max_frequency_ = 0;
-  double deviation_ = 0.0;
+  Real deviation_ = 0;
   std::vector<long> frequencies_;
   std::vector<Matrix> projectors_;
 };
@@ -55,7 +55,7 @@ class TSI_API PeriodicMatrixFlow {
 /// more variable (t' = 1, A padded with a zero row and column, as HOODESolver.jl does): dim()
 /// is A's size + 1, physical variables (u0, u_final, errors) are u without t, and runs start
 /// at t = 0. `u0` (physical, may be empty) is the default initial value.
-TSI_API std::unique_ptr<Model> make_matrix_model(double eps, PeriodicMatrixFlow flow,
+TSI_API std::unique_ptr<Model> make_matrix_model(Real eps, PeriodicMatrixFlow flow,
                                                  std::shared_ptr<const Field> field, bool time_dependent,
                                                  bool is_complex, Vector u0, std::string field_name);
 

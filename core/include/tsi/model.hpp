@@ -29,7 +29,7 @@ class TSI_API Model {
   Model(const Model&) = delete;
   Model& operator=(const Model&) = delete;
 
-  double eps() const { return eps_; }
+  Real eps() const { return eps_; }
 
   // ---- The required core ----------------------------------------------------------------
 
@@ -97,7 +97,7 @@ class TSI_API Model {
   bool has_linear_remainder() const { return linear_remainder().size() > 0; }
 
   /// e^{A tau} applied to one state.
-  Vector linear_flow(double tau, const Vector& u) const;
+  Vector linear_flow(Real tau, const Vector& u) const;
   /// f(u) for one state.
   Vector nonlinear_field(const Vector& u) const;
   /// f_tau(u) = e^{-A tau} f(e^{A tau} u) for column j at tau = taus[j]; `states` is scratch.
@@ -109,18 +109,18 @@ class TSI_API Model {
   /// True when bindings of one tau grid may evaluate on different threads.
   bool independent_tau_grid_bindings() const;
   /// u <- the exact flow of u' = f(u) over time t (tsi::Error without the capability).
-  void nonlinear_flow(double t, Vector& u) const;
+  void nonlinear_flow(Real t, Vector& u) const;
   /// u <- e^{R t} u (coordinate j times e^{i omega_j t}); nothing without a remainder.
-  void remainder_flow(double t, Vector& u) const;
+  void remainder_flow(Real t, Vector& u) const;
 
   /// Oscillatory energy I(u) = <Mu, u> / (2 eps) (tsi::Error without the Hamiltonian structure).
-  double oscillatory_energy(const Vector& u) const;
+  Real oscillatory_energy(const Vector& u) const;
   /// Energy of the remainder, <R' u, u> / 2 with R' u = -J (i omega . u) (0 without one).
-  double remainder_energy(const Vector& u) const;
+  Real remainder_energy(const Vector& u) const;
   /// Mass m(u) = <u, u>.
-  double mass(const Vector& u) const;
+  Real mass(const Vector& u) const;
   /// Energy H(u) = I(u) + <R'u, u>/2 + H1(u), exactly conserved by the flow.
-  double energy(const Vector& u) const;
+  Real energy(const Vector& u) const;
 
   /// Entries of a physical state (dim() without physical variables).
   Index physical_dim() const;
@@ -129,20 +129,20 @@ class TSI_API Model {
   /// The physical state of u (identity without physical variables).
   Vector to_physical(const Vector& u) const;
   /// The norm of relative errors, on physical states (Euclidean without physical variables).
-  double error_norm(const Vector& x) const;
+  Real error_norm(const Vector& x) const;
   /// The shape of a physical state in C order (u_final.npy's): (physical_dim()) by default.
   std::vector<Index> physical_shape() const;
   /// The relative error in physical variables that rounding the model state u alone causes
   /// (one ulp per entry, alternating in sign): no solution held in model variables is more
   /// accurate. Large where to_physical is ill-conditioned (the charged particle's
   /// v = (p + B q) / (2 eps)).
-  double rounding_floor(const Vector& u) const;
+  Real rounding_floor(const Vector& u) const;
 
  protected:
-  explicit Model(double eps);
+  explicit Model(Real eps);
 
  private:
-  double eps_;
+  Real eps_;
 };
 
 }  // namespace tsi

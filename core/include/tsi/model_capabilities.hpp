@@ -79,7 +79,7 @@ class TSI_API HamiltonianStructure {
   /// out = J u.
   virtual void apply_J(const Vector& u, Vector& out) const = 0;
   /// The non-stiff part H1 of the Hamiltonian.
-  virtual double H1(const Vector& u) const = 0;
+  virtual Real H1(const Vector& u) const = 0;
 };
 
 /// The exact flow of u' = f(u) alone (splitting schemes and the direct problem's exact
@@ -88,7 +88,7 @@ class TSI_API ExactNonlinearFlow {
  public:
   virtual ~ExactNonlinearFlow() = default;
   /// u <- the exact flow of u' = f(u) over time t.
-  virtual void nonlinear_flow(double t, Vector& u) const = 0;
+  virtual void nonlinear_flow(Real t, Vector& u) const = 0;
 };
 
 /// Physical variables different from the model's own (an initial value in a config, u_final,
@@ -105,7 +105,7 @@ class TSI_API PhysicalVariables {
   /// The physical state of model variables u.
   virtual Vector to_physical(const Vector& u) const = 0;
   /// The norm relative errors are measured in, on physical states (Euclidean by default).
-  virtual double error_norm(const Vector& x) const { return x.norm(); }
+  virtual Real error_norm(const Vector& x) const { return x.norm(); }
   /// The shape of a physical state as an array in C order, the shape of u_final.npy (a grid's
   /// (n_x, n_y, n_z)); by default flat, (physical_dim()).
   virtual std::vector<Index> physical_shape() const { return {physical_dim()}; }
@@ -117,7 +117,7 @@ class TSI_API PhysicalVariables {
 struct TSI_API ModelInvariant {
   std::string name;         ///< a column name: letters, digits and '_' ("P", "mu")
   std::string description;  ///< one line, for the run's files and plots
-  std::function<double(const Vector& u)> value;  ///< of a state in model variables
+  std::function<Real(const Vector& u)> value;  ///< of a state in model variables
   /// false: a diagnostic recorded beside the invariants (the particle-in-cell electric energy):
   /// its value in each row and its range, no change tracked.
   bool conserved = true;
@@ -130,10 +130,10 @@ class TSI_API ExactSolution {
   virtual ~ExactSolution() = default;
   struct Value {
     Vector x;         ///< u(t), physical variables
-    double accuracy;  ///< its estimated relative error (at least the rounding of x to double)
+    Real accuracy;  ///< its estimated relative error (at least the rounding of x to double)
   };
   /// u(t) from u(0) = x0, both in physical variables, for t >= 0.
-  virtual Value at(const Vector& x0, double t) const = 0;
+  virtual Value at(const Vector& x0, Real t) const = 0;
 };
 
 }  // namespace tsi

@@ -8,7 +8,7 @@ namespace tsi {
 
 /// Reads the state at t_0 and after every step, with the step index and t_n = n h (the run
 /// recorder, dense output, progress). Returning false stops the integration after that step.
-using StepObserver = std::function<bool(long n, double t, const Vector& y)>;
+using StepObserver = std::function<bool(long n, Real t, const Vector& y)>;
 
 /// An observer that may rebuild the state after a step without changing the solution it
 /// represents: the two-scale re-preparation (Reformulation::repreparation). It runs before
@@ -18,7 +18,7 @@ class TSI_API StateObserver {
   virtual ~StateObserver() = default;
   /// After step n (state y at t_n): true when it rebuilt y. The driver then restarts the
   /// stepper (Stepper::reset), as a multistep scheme must.
-  virtual bool after_step(long n, double t, Vector& y) = 0;
+  virtual bool after_step(long n, Real t, Vector& y) = 0;
 };
 
 }  // namespace tsi

@@ -1,15 +1,18 @@
 #pragma once
+#include <numbers>
+
 #include "tsi/export.hpp"
+#include "tsi/types.hpp"
 
 namespace tsi {
 
-inline constexpr double two_pi = 6.283185307179586476925286766559;
+inline constexpr Real two_pi = 2 * std::numbers::pi_v<Real>;
 
 /// The fast phase t/eps reduced to [0, 2*pi), with a rounding error of the order of the
 /// result's ulp: neither the quotient's rounding (ulp(t/eps)) nor the number of periods enters.
-TSI_API double fast_phase(double t, double eps);
+TSI_API Real fast_phase(Real t, Real eps);
 
 /// Time of step n: t_n = n h, computed, never accumulated.
-inline double step_time(long n, double h) { return static_cast<double>(n) * h; }
+inline Real step_time(long n, Real h) { return static_cast<Real>(n) * h; }
 
 }  // namespace tsi

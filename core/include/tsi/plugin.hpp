@@ -13,7 +13,7 @@
 /// order, the ABI version, the size of TsiPluginInfo, the tsi major version and the layout of
 /// every structure the plugin exchanges with tsi, before it calls register_fn.
 /// What is stable and what bumps the version: docs/plugin-abi.md.
-inline constexpr std::uint32_t TSI_PLUGIN_ABI_VERSION = 16;
+inline constexpr std::uint32_t TSI_PLUGIN_ABI_VERSION = 17;
 
 extern "C" {
 
@@ -47,6 +47,9 @@ struct TsiPluginLayout {
   /// 1 when compiled with AddressSanitizer: Eigen then allocates through another allocator, and
   /// memory one side allocates the other frees, so both must agree.
   std::uint32_t address_sanitizer;
+  /// tsi::Real, the build's precision (TSI_PRECISION): a double plugin's states and step sizes
+  /// are not a long-double tsi's.
+  TsiTypeLayout real;
 };
 
 struct TsiPluginInfo {
@@ -87,11 +90,11 @@ constexpr TsiPluginLayout tsi_plugin_layout() {
           layout_of<tsi::FieldEntry>(),
           static_cast<std::uint32_t>(EIGEN_MAX_ALIGN_BYTES),
 #if defined(__SANITIZE_ADDRESS__)
-          1u
+          1u,
 #else
-          0u
+          0u,
 #endif
-  };
+          layout_of<tsi::Real>()};
 }
 
 /// Name of the entry point the loader looks up.

@@ -53,21 +53,21 @@ class TSI_API Problem {
   /// The period in t of the fastest component of the explicit time dependence (filtered:
   /// 2 pi eps / Model::max_linear_frequency()), 0 if none.
   /// Adaptive solvers must not step across it: their error estimates alias.
-  virtual double fast_period() const { return 0.0; }
+  virtual Real fast_period() const { return 0.0; }
 
   /// out = N(t, y).
-  virtual void nonlinear(double t, const Vector& y, Vector& out) = 0;
+  virtual void nonlinear(Real t, const Vector& y, Vector& out) = 0;
   /// out = DN(t, y) dy, the derivative of N at y in direction dy.
-  virtual void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) = 0;
+  virtual void nonlinear_derivative(Real t, const Vector& y, const Vector& dy, Vector& out) = 0;
   /// out = L y + N(t, y).
-  virtual void rhs(double t, const Vector& y, Vector& out) = 0;
+  virtual void rhs(Real t, const Vector& y, Vector& out) = 0;
 
   /// True when linear_flow and nonlinear_flow are available (splitting schemes need them).
   virtual bool has_exact_flows() const { return false; }
   /// y <- e^{hL} y. The default throws tsi::Error.
-  virtual void linear_flow(double h, Vector& y);
+  virtual void linear_flow(Real h, Vector& y);
   /// y <- the exact flow of y' = N(t, y) from t to t + h. The default throws tsi::Error.
-  virtual void nonlinear_flow(double t, double h, Vector& y);
+  virtual void nonlinear_flow(Real t, Real h, Vector& y);
 
   /// Evaluations of N (or of rhs) since construction: the work measure of a run.
   long evaluations() const { return evaluations_; }

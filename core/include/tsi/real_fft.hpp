@@ -24,10 +24,10 @@ class TSI_API RealFftBatch {
 
   /// Values at tau_j = 2 pi j / n -> coefficients, unnormalised (n times the Fourier
   /// coefficients): for callers that fold the 1/n into their next pass. Part p (-1: all rows).
-  void forward_unnormalised(const double* values, Complex* coefficients, int part = -1) const;
+  void forward_unnormalised(const Real* values, Complex* coefficients, int part = -1) const;
   /// Coefficients -> values at tau_j. The coefficients are left as they were; the imaginary
   /// parts of modes 0 and n/2 are taken as zero (as they are for a real U).
-  void backward(const Complex* coefficients, double* values, int part = -1) const;
+  void backward(const Complex* coefficients, Real* values, int part = -1) const;
 
   int n() const { return n_; }
   int howmany() const { return howmany_; }

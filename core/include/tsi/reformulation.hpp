@@ -15,11 +15,11 @@ class TSI_API TwoScaleDiagnostics {
  public:
   virtual ~TwoScaleDiagnostics() = default;
   /// Fraction of the energy of y in the top quarter of the tau spectrum.
-  virtual double tau_roughness(const Vector& y) const = 0;
+  virtual Real tau_roughness(const Vector& y) const = 0;
   /// Fraction of the energy of y away from its tau mean (the non-zero tau modes). Each
   /// characteristic tau - t/eps = const of U is a trajectory of the model; this measures how
   /// far they have spread apart, which the run recorder watches for growth.
-  virtual double tau_spread(const Vector& y) const = 0;
+  virtual Real tau_spread(const Vector& y) const = 0;
   /// The times t_n at which the state was re-prepared.
   virtual std::vector<double> repreparation_times() const = 0;
   /// The order of the prepared data of the last prepare(): below the configured order when
@@ -38,7 +38,7 @@ class TSI_API Reformulation : public Problem {
   /// The initial state y(0) of the problem for the model's initial value u0.
   virtual Vector prepare(const Vector& u0) = 0;
   /// u(t) in model variables from the problem state y at time t.
-  virtual Vector read_back(const Vector& y, double t) = 0;
+  virtual Vector read_back(const Vector& y, Real t) = 0;
   /// The two-scale diagnostics (null for the filtered and direct problems, which have no tau).
   virtual const TwoScaleDiagnostics* two_scale_diagnostics() const { return nullptr; }
   /// The observer that re-prepares the state between steps (two-scale; SPEC.md section 6),

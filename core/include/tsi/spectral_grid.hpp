@@ -42,16 +42,16 @@ class TSI_API SpectralGrid {
   /// |m|^2 = m_1^2 + .. + m_d^2 at every point, in the coefficients' order (the symbol of -lap).
   const RealVector& laplacian_symbol() const { return laplacian_; }
   /// The largest |m|^2, sum of (n_i/2)^2.
-  double max_laplacian_symbol() const;
+  Real max_laplacian_symbol() const;
   /// The 2/3 rule's mask: 1 where every |m_i| <= n_i / 3, 0 elsewhere.
   RealVector dealias_mask() const;
   /// x_i at index j: 2 pi j / n_i.
-  double coordinate(int direction, int j) const;
+  Real coordinate(int direction, int j) const;
   /// Calls point(index, x) for every point in C order, x the point's coordinates (x_1 .. x_d).
   template <class Point>
   void for_each_point(Point&& point) const {
     std::array<int, 3> j{0, 0, 0};
-    std::array<double, 3> x{0.0, 0.0, 0.0};
+    std::array<Real, 3> x{0.0, 0.0, 0.0};
     for (Index p = 0; p < points_; ++p) {
       for (int i = 0; i < dims(); ++i) x[static_cast<std::size_t>(i)] = coordinate(i, j[static_cast<std::size_t>(i)]);
       point(p, x);
@@ -148,7 +148,7 @@ class TSI_API RealGridTransforms {
  private:
   Index points_, half_points_, columns_;
   int n_last_;
-  double* values_ = nullptr;
+  Real* values_ = nullptr;
   Complex* spectrum_ = nullptr;
   std::unique_ptr<detail::LeadingDirections> leading_;  // a large multi-dimensional field: by direction
   void* plans_[2] = {nullptr, nullptr};                  // r2c, c2r
@@ -177,12 +177,12 @@ class TSI_API GridTransformsPool {
 TSI_API ParamSchema spectral_grid_params(const std::string& what);
 /// A plane wave a e^{i k.x} on a SpectralGrid, the data a model offers as `initial: "plane-wave"`.
 struct TSI_API PlaneWave {
-  double amplitude = 1.0;
+  Real amplitude = 1.0;
   std::array<int, 3> wave_vector{1, 0, 0};  ///< k, zero beyond the grid's dims
   /// |k|^2.
-  double k2() const;
+  Real k2() const;
   /// a e^{i k.x} at x.
-  Complex at(const std::array<double, 3>& x) const;
+  Complex at(const std::array<Real, 3>& x) const;
 };
 /// The parameters of a model's initial data on a SpectralGrid: `initial` (`default_name`,
 /// described by `default_doc`, or "plane-wave"), `wave_vector` and `amplitude` (the plane wave's).

@@ -64,18 +64,18 @@ struct TSI_API SolverStats {
 /// (Scheme::bind); nothing is cached by key.
 class TSI_API Stepper {
  public:
-  Stepper(Problem& problem, double h) : problem_(problem), h_(h) {}
+  Stepper(Problem& problem, Real h) : problem_(problem), h_(h) {}
   virtual ~Stepper() = default;
   Stepper(const Stepper&) = delete;
   Stepper& operator=(const Stepper&) = delete;
 
   Problem& problem() const { return problem_; }
   /// The step size it was bound to (negative: it steps backwards).
-  double h() const { return h_; }
+  Real h() const { return h_; }
   /// Forget any history: the next step() starts a new trajectory.
   virtual void reset() {}
   /// Advance y from t to t + h() in place.
-  virtual void step(double t, Vector& y) = 0;
+  virtual void step(Real t, Vector& y) = 0;
   /// Statistics of the implicit stages so far.
   virtual SolverStats stats() const { return {}; }
   /// Vectors of the problem's size the binding holds (coefficients, stages, history, its
@@ -84,7 +84,7 @@ class TSI_API Stepper {
 
  protected:
   Problem& problem_;
-  double h_;
+  Real h_;
 };
 
 /// A scheme: the method with its resolved parameters, apart from any problem. bind() makes
@@ -96,7 +96,7 @@ class TSI_API Scheme {
   static constexpr double unknown_state_vectors = 16.0;
 
   virtual ~Scheme() = default;
-  virtual std::unique_ptr<Stepper> bind(Problem& problem, double h) const = 0;
+  virtual std::unique_ptr<Stepper> bind(Problem& problem, Real h) const = 0;
   /// The vectors of the state's size a binding to a problem of this layout will hold (what its
   /// Stepper's state_vectors() reports), known before the problem is built or anything of its
   /// size allocated: a run's footprint check uses it.
@@ -109,7 +109,7 @@ template <class Bound, class Settings>
 class BindingScheme final : public Scheme {
  public:
   explicit BindingScheme(Settings settings) : settings_(std::move(settings)) {}
-  std::unique_ptr<Stepper> bind(Problem& problem, double h) const override {
+  std::unique_ptr<Stepper> bind(Problem& problem, Real h) const override {
     return std::make_unique<Bound>(problem, h, settings_);
   }
   double state_vectors(const ProblemLayout& layout) const override {

@@ -3,26 +3,40 @@
 #include <cmath>
 #include <complex>
 
+#include "tsi/precision.hpp"
+
 namespace tsi {
 
-using Complex = std::complex<double>;
+/// The real type of states, times, step sizes and scheme coefficients: double, or long double
+/// in a build configured with TSI_PRECISION=long-double (precision.hpp). Counters, timings
+/// and memory figures stay double in every build.
+using Real = TSI_REAL_TYPE;
+using Complex = std::complex<Real>;
 /// A state: complex throughout (real models keep zero imaginary parts).
-using Vector = Eigen::VectorXcd;
-using RealVector = Eigen::VectorXd;
+using Vector = Eigen::Matrix<Complex, Eigen::Dynamic, 1>;
+using RealVector = Eigen::Matrix<Real, Eigen::Dynamic, 1>;
 /// A batch of states, one per column (column j is the state at the j-th tau point).
-using Matrix = Eigen::MatrixXcd;
+using Matrix = Eigen::Matrix<Complex, Eigen::Dynamic, Eigen::Dynamic>;
 using MatrixRef = Eigen::Ref<Matrix>;
 using ConstMatrixRef = Eigen::Ref<const Matrix>;
 /// A batch of real states (a real model's tau grid), one per column.
-using RealMatrix = Eigen::MatrixXd;
+using RealMatrix = Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic>;
 using RealMatrixRef = Eigen::Ref<RealMatrix>;
 using Index = Eigen::Index;
 
 /// Real inner product <u, v> = Re sum conj(u_i) v_i.
-inline double inner(const Vector& u, const Vector& v) { return u.dot(v).real(); }
+inline Real inner(const Vector& u, const Vector& v) { return u.dot(v).real(); }
 
 /// Largest modulus of the entries (0 for an empty vector). Squared moduli are compared,
 /// so there is one square root, not one hypot per entry.
-inline double max_norm(const Vector& v) { return v.size() ? std::sqrt(v.cwiseAbs2().maxCoeff()) : 0.0; }
+inline Real max_norm(const Vector& v) { return v.size() ? std::sqrt(v.cwiseAbs2().maxCoeff()) : Real(0); }
+
+/// The smallest relative tolerance an adaptive reference solver takes: 1e-16 in a double
+/// build, 1e-20 in a long-double one (each just below its unit roundoff).
+inline constexpr double smallest_tolerance = sizeof(Real) == sizeof(double) ? 1e-16 : 1e-20;
+
+/// A Real as a double: the figures a run records (errors, invariants, norms) are written
+/// as doubles, whose range holds every error an extended build reaches.
+inline double to_double(Real x) { return static_cast<double>(x); }
 
 }  // namespace tsi

@@ -16,14 +16,14 @@ void require_linear_to_physical(const Model& model) {
   // Two states of the model's dimension (not its initial value: a model may have no default).
   Vector a(model.dim()), b(model.dim());
   for (Index i = 0; i < a.size(); ++i) {
-    a(i) = 0.1 + 0.9 * static_cast<double>(i % 7) / 7.0;
-    const double w = 0.3 + 0.7 * static_cast<double>(i + 1) / static_cast<double>(a.size());
+    a(i) = 0.1 + 0.9 * static_cast<Real>(i % 7) / 7.0;
+    const Real w = 0.3 + 0.7 * static_cast<Real>(i + 1) / static_cast<Real>(a.size());
     b(i) = model.is_complex() ? Complex(w, 0.5 * w) : Complex(w, 0.0);
   }
   const Vector lhs = model.to_physical(a + 2.0 * b);
   const Vector rhs = model.to_physical(a) + 2.0 * model.to_physical(b);
-  const double scale = std::max(max_norm(lhs), max_norm(rhs));
-  if (!(max_norm(lhs - rhs) <= 1e-10 * std::max(scale, 1.0)))
+  const Real scale = std::max(max_norm(lhs), max_norm(rhs));
+  if (!(max_norm(lhs - rhs) <= 1e-10 * std::max<Real>(scale, 1)))
     throw ConfigError("reformulation.variables",
                       fmt::format("got \"physical\", but the model maps to physical variables non-linearly "
                                   "(T(a + 2b) - T(a) - 2 T(b) = {:.3e}); expected \"model\"",
@@ -68,7 +68,7 @@ void Direct::store(const Vector& values, Vector& out) const {
   if (&out != &values) packing_.pack_into(values.data(), out);
 }
 
-void Direct::linear_flow(double h, Vector& y) {
+void Direct::linear_flow(Real h, Vector& y) {
   if (!packing_.on()) {
     y = model_->linear_flow(fast_phase(h, model_->eps()), y);
     model_->remainder_flow(h, y);
@@ -79,7 +79,7 @@ void Direct::linear_flow(double h, Vector& y) {
   store(x, y);
 }
 
-void Direct::nonlinear_flow(double /*t*/, double h, Vector& y) {
+void Direct::nonlinear_flow(Real /*t*/, Real h, Vector& y) {
   ++evaluations_;
   if (!packing_.on()) return model_->nonlinear_flow(h, y);
   packing_.unpack(y.data(), x_.data());
@@ -119,9 +119,9 @@ void Direct::evaluate(const Vector& y, Vector& out, bool with_linear_part) {
   store(result, out);
 }
 
-void Direct::nonlinear(double /*t*/, const Vector& y, Vector& out) { evaluate(y, out, false); }
+void Direct::nonlinear(Real /*t*/, const Vector& y, Vector& out) { evaluate(y, out, false); }
 
-void Direct::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& dy, Vector& out) {
+void Direct::nonlinear_derivative(Real /*t*/, const Vector& y, const Vector& dy, Vector& out) {
   const Vector x = packing_.unpacked(y), dx = packing_.unpacked(dy);
   state_.col(0) = physical_ ? model_->from_physical(x) : x;
   direction_.col(0) = physical_ ? model_->from_physical(dx) : dx;
@@ -129,6 +129,6 @@ void Direct::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& d
   store(physical_ ? model_->to_physical(field_.col(0)) : Vector(field_.col(0)), out);
 }
 
-void Direct::rhs(double /*t*/, const Vector& y, Vector& out) { evaluate(y, out, true); }
+void Direct::rhs(Real /*t*/, const Vector& y, Vector& out) { evaluate(y, out, true); }
 
 }  // namespace tsi

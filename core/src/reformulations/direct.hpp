@@ -27,18 +27,18 @@ class Direct final : public Reformulation {
   /// True when the state holds a real model's values two to an entry.
   bool real_layout() const { return packing_.on(); }
   const Diagonal& linear_multipliers() const override { return none_; }
-  void nonlinear(double t, const Vector& y, Vector& out) override;
-  void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
-  void rhs(double t, const Vector& y, Vector& out) override;
+  void nonlinear(Real t, const Vector& y, Vector& out) override;
+  void nonlinear_derivative(Real t, const Vector& y, const Vector& dy, Vector& out) override;
+  void rhs(Real t, const Vector& y, Vector& out) override;
 
   /// Exact flows when the model has an exact nonlinear flow: e^{hL} = e^{JM h/eps}.
   bool has_exact_flows() const override { return !physical_ && model_->has_exact_nonlinear_flow(); }
-  void linear_flow(double h, Vector& y) override;
+  void linear_flow(Real h, Vector& y) override;
   /// One exact nonlinear flow counts as one evaluation of N (the work measure of splitting).
-  void nonlinear_flow(double t, double h, Vector& y) override;
+  void nonlinear_flow(Real t, Real h, Vector& y) override;
 
   Vector prepare(const Vector& u0) override { return packing_.packed(physical_ ? model_->to_physical(u0) : u0); }
-  Vector read_back(const Vector& y, double /*t*/) override {
+  Vector read_back(const Vector& y, Real /*t*/) override {
     const Vector x = packing_.unpacked(y);
     return physical_ ? model_->from_physical(x) : x;
   }

@@ -20,12 +20,12 @@ Filtered::Filtered(std::shared_ptr<const Model> model, bool real_layout)
   diagonal_ = Diagonal(multipliers_);
 }
 
-void Filtered::rhs(double t, const Vector& y, Vector& out) {
+void Filtered::rhs(Real t, const Vector& y, Vector& out) {
   nonlinear(t, y, out);
   if (has_remainder_) out += multipliers_.cwiseProduct(y);
 }
 
-void Filtered::nonlinear(double t, const Vector& y, Vector& out) {
+void Filtered::nonlinear(Real t, const Vector& y, Vector& out) {
   ++evaluations_;
   tau_(0) = fast_phase(t, model_->eps());
   load(y, state_);
@@ -42,7 +42,7 @@ void Filtered::load(const Vector& y, Matrix& values) const {
 
 void Filtered::store(const Matrix& values, Vector& out) const { packing_.pack_into(values.data(), out); }
 
-void Filtered::nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) {
+void Filtered::nonlinear_derivative(Real t, const Vector& y, const Vector& dy, Vector& out) {
   tau_(0) = fast_phase(t, model_->eps());
   minus_tau_(0) = -tau_(0);
   load(y, state_);
@@ -54,7 +54,7 @@ void Filtered::nonlinear_derivative(double t, const Vector& y, const Vector& dy,
   store(field_, out);
 }
 
-Vector Filtered::read_back(const Vector& y, double t) {
+Vector Filtered::read_back(const Vector& y, Real t) {
   return model_->linear_flow(fast_phase(t, model_->eps()), packing_.unpacked(y));
 }
 

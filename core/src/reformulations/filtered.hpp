@@ -21,13 +21,13 @@ class Filtered final : public Reformulation {
   const Vector& remainder_multipliers() const override { return has_remainder_ ? multipliers_ : none_; }
   /// The shortest period of the explicit time dependence: 2 pi eps over the model's
   /// largest linear frequency (2 pi eps for Henon-Heiles; 2 pi eps / 64 for NLS with N_x = 16).
-  double fast_period() const override { return two_pi * model_->eps() / model_->max_linear_frequency(); }
-  void nonlinear(double t, const Vector& y, Vector& out) override;
-  void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
-  void rhs(double t, const Vector& y, Vector& out) override;
+  Real fast_period() const override { return two_pi * model_->eps() / model_->max_linear_frequency(); }
+  void nonlinear(Real t, const Vector& y, Vector& out) override;
+  void nonlinear_derivative(Real t, const Vector& y, const Vector& dy, Vector& out) override;
+  void rhs(Real t, const Vector& y, Vector& out) override;
 
   Vector prepare(const Vector& u0) override { return packing_.packed(u0); }
-  Vector read_back(const Vector& y, double t) override;
+  Vector read_back(const Vector& y, Real t) override;
 
  private:
   Vector multipliers_;  // i omega of the remainder, or zeros

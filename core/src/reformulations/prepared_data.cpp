@@ -17,8 +17,8 @@ namespace {
 /// The asymptotic recursion's stopping rule: order k (> 2) is kept while its correction to
 /// order k - 1 does not grow. Growth at the rounding level of the data is noise, not
 /// divergence: those corrections are kept.
-bool keeps_decreasing(int k, double correction, double last_correction, double data_norm) {
-  const double rounding = 64.0 * std::numeric_limits<double>::epsilon() * data_norm;
+bool keeps_decreasing(int k, Real correction, Real last_correction, Real data_norm) {
+  const Real rounding = 64.0 * std::numeric_limits<Real>::epsilon() * data_norm;
   return k <= 2 || correction <= std::max(last_correction, rounding);
 }
 
@@ -36,13 +36,13 @@ int trajectory_point_count(int order, bool remainder) { return remainder || orde
 /// 0.03), the fast rotations of a remainder do not (Klein-Gordon, order 7 at eps = 1/256:
 /// 1.7e-14 at 0.01, 1.5e-12 at 0.03). Measured on Henon-Heiles, NLS, the charged particle and
 /// Klein-Gordon at eps = 1e-4 .. 1 (docs/high-order.md).
-double trajectory_length(int m, bool remainder) { return m > 5 && !remainder ? 0.03 : 0.01; }
+Real trajectory_length(int m, bool remainder) { return m > 5 && !remainder ? 0.03 : 0.01; }
 // The order of the central quotients' data where the trajectory's sweeps diverge.
 constexpr int central_fallback_order = 4;
 
 }  // namespace
 
-PreparedData::PreparedData(TauGrid& grid, double eps, Vector remainder, int order, DataMethod method)
+PreparedData::PreparedData(TauGrid& grid, Real eps, Vector remainder, int order, DataMethod method)
     : grid_(grid),
       dim_(grid.dim()),
       n_tau_(grid.n_tau()),
@@ -83,13 +83,13 @@ Matrix PreparedData::r2(const Vector& w) {
   return r;
 }
 
-Vector PreparedData::at(const Vector& v, double s) {
+Vector PreparedData::at(const Vector& v, Real s) {
   Vector out;
   at(v, s, out);
   return out;
 }
 
-void PreparedData::at(const Vector& v, double s, Vector& out) {
+void PreparedData::at(const Vector& v, Real s, Vector& out) {
   order_reached_ = order_;  // the recursions lower it where they stop early
   phase_ = s;
   if (method_ == DataMethod::automatic && order_ <= 2 && grid_.real_layout()) return low_order_data(v, s, out);
@@ -103,7 +103,7 @@ void PreparedData::at(const Vector& v, double s, Vector& out) {
   out = Eigen::Map<const Vector>(c.data(), grid_.size());
 }
 
-void PreparedData::low_order_data(const Vector& v, double s, Vector& out) {
+void PreparedData::low_order_data(const Vector& v, Real s, Vector& out) {
   // Order 2: U = v + eps (r1(v) - r1(v)(s)), r1 = A f_.(v), with f_tau of the constant grid v
   // evaluated as the state's nonlinearity at the zero state shifted by v (out is that zero
   // state: the evaluation reads it into its grid before it writes); order 1: U = v.
@@ -114,7 +114,7 @@ void PreparedData::low_order_data(const Vector& v, double s, Vector& out) {
     grid_.nonlinear(out, &v, out, s);
     for (int j = 0; j < columns_; ++j) {
       const Complex a = grid_.antiderivative(j);
-      if (a == 0.0)
+      if (a == Complex(0))
         c.col(j).setZero();
       else
         c.col(j) *= eps_ * a;
@@ -124,7 +124,7 @@ void PreparedData::low_order_data(const Vector& v, double s, Vector& out) {
   c.col(0) += v;
 }
 
-Matrix PreparedData::closed_data(const Vector& v, double s) {
+Matrix PreparedData::closed_data(const Vector& v, Real s) {
   Matrix c;
   if (order_ < 2) c = Matrix::Zero(dim_, n_tau_);
   if (order_ >= 2) {
@@ -145,7 +145,7 @@ Matrix PreparedData::closed_data(const Vector& v, double s) {
   return c;
 }
 
-Matrix PreparedData::central_data(const Vector& v, double s, int order) {
+Matrix PreparedData::central_data(const Vector& v, Real s, int order) {
   // The base point from the fixed point u = v - Phi(u)(s), one iteration per order (each gains
   // a factor eps), as HOODESolver.jl does: U = u + Phi^k(u_prev), exact at s by construction.
   // The expansion is asymptotic: at eps near 1 its corrections stop decreasing (Henon-Heiles at
@@ -154,14 +154,14 @@ Matrix PreparedData::central_data(const Vector& v, double s, int order) {
   Matrix data = Matrix::Zero(dim_, n_tau_), c = data;
   data.col(0) = v;
   Vector u = v;
-  double last_correction = std::numeric_limits<double>::infinity();
+  Real last_correction = std::numeric_limits<Real>::infinity();
   order_reached_ = 1;
   for (int k = 2; k <= order; ++k) {
     Matrix next = central_phi(u, k);
     const Vector next_u = v - grid_.evaluate(next, s);
     Matrix candidate = next;
     candidate.col(0) += next_u;
-    const double correction = grid_.norm_from_squares((candidate - data).squaredNorm());
+    const Real correction = grid_.norm_from_squares((candidate - data).squaredNorm());
     if (!keeps_decreasing(k, correction, last_correction, grid_.norm_from_squares(data.squaredNorm()))) break;
     last_correction = correction;
     data.swap(candidate);
@@ -186,15 +186,15 @@ Matrix PreparedData::central_phi(const Vector& u, int k) {
     // (docs/high-order.md has the measurement).
     Vector g = f.col(0);
     if (remainder_.size()) g += remainder_.cwiseProduct(u);
-    const double d = std::pow(eps_, 0.25 * (k - 2));
-    const auto at = [&](double shift) { return central_phi(u + shift * d * g, k - 1); };
+    const Real d = std::pow(eps_, 0.25 * (k - 2));
+    const auto at = [&](Real shift) { return central_phi(u + shift * d * g, k - 1); };
     const Matrix derivative = (8.0 * (at(1.0) - at(-1.0)) - (at(2.0) - at(-2.0))) / (12.0 * d);
     rhs -= derivative;
   }
   return eps_ * grid_.apply_A(rhs);
 }
 
-Matrix PreparedData::trajectory_data(const Vector& v, double s) {
+Matrix PreparedData::trajectory_data(const Vector& v, Real s) {
   // The recursion of central_data, with D Phi^{k-1}(u) G taken as d/dsigma along one trajectory
   // sigma -> c(sigma) of the averaged flow c' = G(c) through the base point: on it every level
   // closes on the points c_i = c(h x_i) themselves, Phi^k(c_i) = eps A [ f(c_i + Phi^{k-1}(c_i))
@@ -223,9 +223,9 @@ Matrix PreparedData::trajectory_data(const Vector& v, double s) {
   Vector drift = f.col(0);
   f.resize(0, 0);
   if (remainder) drift += remainder_.cwiseProduct(v);
-  const double speed = grid_.norm_from_squares(drift.squaredNorm()) / grid_.norm_from_squares(v.squaredNorm());
-  const double length = trajectory_length(static_cast<int>(nodes.x.size()), remainder);
-  const double h = speed > 0.0 && std::isfinite(speed) ? length / speed : length;
+  const Real speed = grid_.norm_from_squares(drift.squaredNorm()) / grid_.norm_from_squares(v.squaredNorm());
+  const Real length = trajectory_length(static_cast<int>(nodes.x.size()), remainder);
+  const Real h = speed > 0.0 && std::isfinite(speed) ? length / speed : length;
   const int m = static_cast<int>(nodes.x.size()), c = nodes.center;
   const std::optional<std::vector<Vector>> trajectory = averaged_trajectory(v, s, nodes, h, drift);
   // No trajectory where the expansion diverges from its first orders on (eps near 1): there the
@@ -237,12 +237,12 @@ Matrix PreparedData::trajectory_data(const Vector& v, double s) {
   Matrix data = Matrix::Zero(dim_, n_tau_);
   data.col(0) = v;
   std::vector<Vector> previous(m, Vector::Zero(grid_.size())), next(m, Vector(grid_.size())), drifts(m);
-  double last_correction = std::numeric_limits<double>::infinity();
+  Real last_correction = std::numeric_limits<Real>::infinity();
   for (int k = 2; k <= order_; ++k) {
     trajectory_level(points, previous, nodes, h, next, drifts, k == order_ ? c : -1);
     Matrix candidate = grid_.all_modes(Eigen::Map<const Matrix>(next[c].data(), dim_, columns_));
     candidate.col(0) += v - grid_.evaluate(candidate, s);  // U(s) = v exactly
-    const double correction = grid_.norm_from_squares((candidate - data).squaredNorm());
+    const Real correction = grid_.norm_from_squares((candidate - data).squaredNorm());
     if (!keeps_decreasing(k, correction, last_correction, grid_.norm_from_squares(data.squaredNorm()))) break;
     last_correction = correction;
     data.swap(candidate);
@@ -252,8 +252,8 @@ Matrix PreparedData::trajectory_data(const Vector& v, double s) {
   return data;
 }
 
-std::optional<std::vector<Vector>> PreparedData::averaged_trajectory(const Vector& v, double s, const SigmaNodes& nodes,
-                                                                 double h, const Vector& drift) {
+std::optional<std::vector<Vector>> PreparedData::averaged_trajectory(const Vector& v, Real s, const SigmaNodes& nodes,
+                                                                 Real h, const Vector& drift) {
   // Sweeps of the whole system at once: Phi at the points gains an order, the base point
   // u = v - Phi(u)(s) follows it, and the trajectory takes a Picard step with the averaged field
   // they give. The data of order p then lose eps |du| to the base point and eps^2 |dc| to the
@@ -261,19 +261,19 @@ std::optional<std::vector<Vector>> PreparedData::averaged_trajectory(const Vecto
   const int m = static_cast<int>(nodes.x.size()), c = nodes.center;
   std::vector<Vector> points = picard_step(v, std::vector<Vector>(m, drift), nodes, h);
   std::vector<Vector> phi(m, Vector::Zero(grid_.size())), next(m, Vector(grid_.size())), drifts(m);
-  const double target =
-      std::max(64.0 * std::numeric_limits<double>::epsilon(), 1e-3 * std::pow(eps_, order_)) *
+  const Real target =
+      std::max(64.0 * std::numeric_limits<Real>::epsilon(), 1e-3 * std::pow(eps_, order_)) *
       grid_.norm_from_squares(v.squaredNorm());
   // The sweeps gain about a factor eps each; where they gain less (Klein-Gordon at eps = 1e-2:
   // 5-10x) the data's own truncation is as slow, and a few sweeps more suffice.
   const int max_sweeps = order_ + 4;
   Vector u = v;
-  double last_change = std::numeric_limits<double>::infinity();
+  Real last_change = std::numeric_limits<Real>::infinity();
   for (int sweep = 1; sweep <= max_sweeps; ++sweep) {
     trajectory_level(points, phi, nodes, h, next, drifts);
     const Vector next_u = v - grid_.evaluate(Eigen::Map<const Matrix>(next[c].data(), dim_, columns_), s);
     std::vector<Vector> next_points = picard_step(next_u, drifts, nodes, h);
-    double change = 0.0, moved = 0.0;
+    Real change = 0.0, moved = 0.0;
     for (int i = 0; i < m; ++i) {
       change = std::max(change, grid_.coefficient_norm(next[i] - phi[i]));
       moved = std::max(moved, grid_.norm_from_squares((next_points[i] - points[i]).squaredNorm()));
@@ -281,7 +281,7 @@ std::optional<std::vector<Vector>> PreparedData::averaged_trajectory(const Vecto
     // Near eps = 1 the sweeps can diverge with the asymptotic series: no trajectory then.
     if (sweep > 2 && !(change < 2.0 * last_change)) return std::nullopt;
     last_change = change;
-    const double error = eps_ * grid_.norm_from_squares((next_u - u).squaredNorm()) + eps_ * eps_ * moved;
+    const Real error = eps_ * grid_.norm_from_squares((next_u - u).squaredNorm()) + eps_ * eps_ * moved;
     phi.swap(next);
     points.swap(next_points);
     u = next_u;
@@ -291,7 +291,7 @@ std::optional<std::vector<Vector>> PreparedData::averaged_trajectory(const Vecto
 }
 
 void PreparedData::trajectory_level(const std::vector<Vector>& points, const std::vector<Vector>& previous,
-                                const SigmaNodes& nodes, double h, std::vector<Vector>& next,
+                                const SigmaNodes& nodes, Real h, std::vector<Vector>& next,
                                 std::vector<Vector>& drift, int only) {
   const int m = static_cast<int>(points.size());
   const auto phi = [&](int j) { return Eigen::Map<const Matrix>(previous[j].data(), dim_, columns_); };
@@ -305,7 +305,7 @@ void PreparedData::trajectory_level(const std::vector<Vector>& points, const std
     for (int col = 0; col < columns_; ++col) {
       auto mode = rhs.col(col);
       const Complex factor = eps_ * grid_.antiderivative(col);
-      if (factor == 0.0) {
+      if (factor == Complex(0)) {
         mode.setZero();
         continue;
       }
@@ -318,7 +318,7 @@ void PreparedData::trajectory_level(const std::vector<Vector>& points, const std
 }
 
 std::vector<Vector> PreparedData::picard_step(const Vector& u, const std::vector<Vector>& drift, const SigmaNodes& nodes,
-                                          double h) const {
+                                          Real h) const {
   const int m = static_cast<int>(drift.size());
   std::vector<Vector> points(m, u);
   for (int i = 0; i < m; ++i)

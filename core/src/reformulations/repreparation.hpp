@@ -13,8 +13,8 @@ struct Repreparation {
   long every = 0;         ///< Every: each this many steps
   /// Auto: re-prepare when U's distance from the prepared data at its own diagonal value,
   /// |U - P(v_n, s_n)|, exceeds this fraction of P's own tau variation |P - mean P|.
-  double defect = 0.1;
-  double defect_floor = 1e-4;  ///< Auto: defects below this fraction of |U| never trigger
+  Real defect = 0.1;
+  Real defect_floor = 1e-4;  ///< Auto: defects below this fraction of |U| never trigger
   long min_gap = 10;  ///< Auto: tested (one evaluation of r1) every this many steps
 };
 
@@ -24,11 +24,11 @@ struct Repreparation {
 /// driver calls it as an observer of the state (TwoScale::repreparation).
 class Repreparer final : public StateObserver {
  public:
-  Repreparer(const TauGrid& grid, PreparedData& data, double eps, Repreparation rule)
+  Repreparer(const TauGrid& grid, PreparedData& data, Real eps, Repreparation rule)
       : grid_(grid), data_(data), eps_(eps), rule_(rule) {}
 
   /// After step n (at time t): re-prepares y when due; true when it did.
-  bool after_step(long n, double t, Vector& y) override;
+  bool after_step(long n, Real t, Vector& y) override;
   /// A new run: no re-preparation yet (the initial data are the last prepared, at step 0).
   void reset() {
     times_.clear();
@@ -39,7 +39,7 @@ class Repreparer final : public StateObserver {
  private:
   const TauGrid& grid_;
   PreparedData& data_;
-  double eps_;
+  Real eps_;
   Repreparation rule_;
   std::vector<double> times_;
   long last_prepared_ = 0;  // the step of the last preparation

@@ -1,5 +1,5 @@
 #pragma once
-#include <Eigen/Dense>
+#include "tsi/types.hpp"
 
 namespace tsi {
 
@@ -9,9 +9,9 @@ namespace tsi {
 struct SigmaNodes {
   explicit SigmaNodes(int m);
 
-  Eigen::VectorXd x;
-  Eigen::MatrixXd differentiate;  ///< (D v)_i = p'(x_i), p the interpolant of the values v
-  Eigen::MatrixXd integrate;      ///< (S v)_i = int_0^{x_i} p
+  RealVector x;
+  RealMatrix differentiate;  ///< (D v)_i = p'(x_i), p the interpolant of the values v
+  RealMatrix integrate;      ///< (S v)_i = int_0^{x_i} p
   int center;                     ///< the index of x = 0
 };
 

@@ -98,7 +98,7 @@ void TauGrid::set_diagonal(Vector diagonal) {
   for (auto& field : column_fields_) field->set_diagonal(diagonal_);
 }
 
-void TauGrid::nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, double phase) {
+void TauGrid::nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, Real phase) {
   ++*evaluations_;
   if (needs_diagonal_) {
     Vector diagonal = evaluate(Eigen::Map<const Matrix>(y.data(), dim_, columns_), phase);
@@ -172,7 +172,7 @@ void TauGrid::on_grid_threads(In&& transform_in, Field&& evaluate, Out&& transfo
 void TauGrid::nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& out) {
   out.resize(size());
   const bool in_place = field_values_.size() == 0;
-  const double* field = in_place ? grid_values_.data() : field_values_.data();
+  const Real* field = in_place ? grid_values_.data() : field_values_.data();
   const auto transform_in = [&](int part) {
     // The mean shift is a constant in tau: added to the grid values, as to the mean mode.
     real_fft_->backward(y.data(), grid_values_.data(), part);
@@ -181,7 +181,7 @@ void TauGrid::nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& 
     const Index rn = part < 0 ? dim_ : real_fft_->part_begin(part + 1) - r0;
     grid_values_.middleRows(r0, rn).colwise() += mean_shift->segment(r0, rn).real();
   };
-  const double scale = 1.0 / n_tau_;  // the 1/n of the transform
+  const Real scale = 1.0 / n_tau_;  // the 1/n of the transform
   if (threads_ <= 1) {
     transform_in(-1);
     evaluate_real_grid(*grid_field_, 0, n_tau_);
@@ -241,15 +241,15 @@ Matrix TauGrid::all_modes(ConstMatrixRef stored) const {
   return c;
 }
 
-double TauGrid::coefficient_norm(const Vector& y, bool without_mean) const {
+Real TauGrid::coefficient_norm(const Vector& y, bool without_mean) const {
   const Eigen::Map<const Matrix> c(y.data(), dim_, columns_);
-  double sum = 0.0;
+  Real sum = 0.0;
   for (int j = without_mean ? 1 : 0; j < columns_; ++j)
     sum += (real_layout_ && j > 0 && 2 * j < n_tau_ ? 2.0 : 1.0) * c.col(j).squaredNorm();
   return norm_from_squares(sum);
 }
 
-double TauGrid::norm_from_squares(double squares) const {
+Real TauGrid::norm_from_squares(Real squares) const {
   if (collective_) collective_->sum(&squares, 1);
   return std::sqrt(squares);
 }
@@ -282,7 +282,7 @@ Matrix TauGrid::df_coefficients(Matrix w, Matrix z) {
 
 Matrix TauGrid::apply_A(Matrix c) const {
   for (int j = 0; j < n_tau_; ++j) {
-    if (antiderivative(j) == 0.0)
+    if (antiderivative(j) == Complex(0))
       c.col(j).setZero();
     else
       c.col(j) /= Complex(0.0, wave_numbers_(j));
@@ -291,18 +291,18 @@ Matrix TauGrid::apply_A(Matrix c) const {
 }
 
 Complex TauGrid::antiderivative(int j) const {
-  return j == 0 || 2 * j == n_tau_ ? Complex(0.0) : 1.0 / Complex(0.0, wave_numbers_(j));
+  return j == 0 || 2 * j == n_tau_ ? Complex(0) : Real(1) / Complex(0, wave_numbers_(j));
 }
 
 
-Vector TauGrid::evaluate(ConstMatrixRef c, double tau) const {
+Vector TauGrid::evaluate(ConstMatrixRef c, Real tau) const {
   Vector value = Vector::Zero(dim_);
   const bool real = c.cols() != n_tau_;  // the real layout: modes k and -k together, 2 Re(c_k e^{i k tau})
   std::vector<Complex> factors(static_cast<std::size_t>(c.cols()));
   for (int j = 0; j < c.cols(); ++j)
     factors[static_cast<std::size_t>(j)] = 2 * j == n_tau_ ? Complex(std::cos(0.5 * n_tau_ * tau))  // half at +-n/2
-                                           : real          ? std::polar(1.0, j * tau)
-                                                           : std::polar(1.0, wave_numbers_(j) * tau);
+                                           : real          ? std::polar(Real(1), j * tau)
+                                                           : std::polar(Real(1), wave_numbers_(j) * tau);
   // By blocks of rows, each summed over the modes in order (the same numbers on any number of
   // threads): a particle state read back every step is 10^7 rows.
   constexpr Index block = 1 << 14;

@@ -43,7 +43,7 @@ class TauGrid {
   /// at c_i + Phi_i without a copy of Phi_i. The grid is formed in out's storage.
   /// `phase`: tau on the diagonal at the evaluation's time (t/eps), for a field that reads
   /// U there (TauGridField::needs_diagonal).
-  void nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, double phase);
+  void nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, Real phase);
 
   /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau), computed in W's storage where
   /// the model evaluates in place. A field that reads the diagonal reads W at tau = 0 (the
@@ -59,13 +59,13 @@ class TauGrid {
   /// are the conjugates of the modes k).
   Matrix all_modes(ConstMatrixRef stored) const;
   /// The norm of the coefficients of a state as if all N_tau modes were stored.
-  double coefficient_norm(const Vector& y, bool without_mean = false) const;
+  Real coefficient_norm(const Vector& y, bool without_mean = false) const;
   /// sqrt(squares) over every process of a split run (Context::collective): the 2-norm of a
   /// state, or of tau data, from the sum of its squares on this process's rows.
-  double norm_from_squares(double squares) const;
+  Real norm_from_squares(Real squares) const;
   /// The trigonometric interpolant of coefficients c at tau (Nyquist split half/half); c holds
   /// all N_tau modes or the real layout's N_tau/2 + 1.
-  Vector evaluate(ConstMatrixRef c, double tau) const;
+  Vector evaluate(ConstMatrixRef c, Real tau) const;
   /// A = (d/dtau)^{-1} (I - Pi) on coefficients: mode k / (i k), modes 0 and Nyquist to 0.
   Matrix apply_A(Matrix c) const;
   /// A's multiplier on the Fourier index j: 1 / (i k), 0 on modes 0 and Nyquist.

@@ -24,7 +24,7 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
   Vector multipliers(run == 1 ? dim * columns : columns);
   for (int j = 0; j < columns; ++j) {  // the real layout stores modes 0 .. n/2
     // Nyquist: -i k / eps is 0 there, as the Fourier differentiation matrix has it.
-    const double k = (2 * j == n_tau) ? 0.0 : grid_.wave_numbers()(j);
+    const Real k = (2 * j == n_tau) ? 0.0 : grid_.wave_numbers()(j);
     if (run > 1) {
       multipliers(j) = Complex(0.0, -k / eps_);
       continue;
@@ -39,7 +39,7 @@ void TwoScale::average_nyquist() {
   const int n_tau = grid_.n_tau(), nyquist = n_tau / 2;
   const Index run = multipliers_.run();
   RealVector pairs = RealVector::Zero(multipliers_.values().size());
-  const double k = nyquist / eps_;
+  const Real k = nyquist / eps_;
   if (run > 1)
     pairs(nyquist) = k;
   else
@@ -59,9 +59,9 @@ double TwoScale::work_vectors(const Model& model, int initial_data_order, const 
   return 1.0 + (remainder ? 2.0 : 0.0) + prepare;
 }
 
-void TwoScale::nonlinear(double t, const Vector& y, Vector& out) { grid_.nonlinear(y, nullptr, out, fast_phase(t, eps_)); }
+void TwoScale::nonlinear(Real t, const Vector& y, Vector& out) { grid_.nonlinear(y, nullptr, out, fast_phase(t, eps_)); }
 
-void TwoScale::nonlinear_derivative(double /*t*/, const Vector& y, const Vector& dy, Vector& out) {
+void TwoScale::nonlinear_derivative(Real /*t*/, const Vector& y, const Vector& dy, Vector& out) {
   const Index dim = grid_.dim();
   const int columns = grid_.columns();
   const Matrix result =
@@ -70,7 +70,7 @@ void TwoScale::nonlinear_derivative(double /*t*/, const Vector& y, const Vector&
   out = Eigen::Map<const Vector>(result.data(), size());  // modes 0 .. columns - 1
 }
 
-void TwoScale::rhs(double t, const Vector& y, Vector& out) {
+void TwoScale::rhs(Real t, const Vector& y, Vector& out) {
   nonlinear(t, y, out);
   algebra::diagonal_multiply_add(out, multipliers_, y, out);
 }
@@ -80,17 +80,17 @@ Vector TwoScale::prepare(const Vector& u0) {
   return data_.at(u0, 0.0);
 }
 
-Vector TwoScale::read_back(const Vector& y, double t) {
-  const double tau = fast_phase(t, eps_);
+Vector TwoScale::read_back(const Vector& y, Real t) {
+  const Real tau = fast_phase(t, eps_);
   return model_->linear_flow(tau, grid_.evaluate(Eigen::Map<const Matrix>(y.data(), grid_.dim(), grid_.columns()), tau));
 }
 
-double TwoScale::tau_roughness(const Vector& y) const {
+Real TwoScale::tau_roughness(const Vector& y) const {
   const int columns = grid_.columns(), n_tau = grid_.n_tau();
   const Eigen::Map<const Matrix> c(y.data(), grid_.dim(), columns);
-  double total = 0.0, top = 0.0;
+  Real total = 0.0, top = 0.0;
   for (int j = 0; j < columns; ++j) {
-    const double e = (grid_.real_layout() && j > 0 && 2 * j < n_tau ? 2.0 : 1.0) * c.col(j).squaredNorm();
+    const Real e = (grid_.real_layout() && j > 0 && 2 * j < n_tau ? 2.0 : 1.0) * c.col(j).squaredNorm();
     total += e;
     if (8.0 * std::abs(grid_.wave_numbers()(j)) > 3.0 * n_tau) top += e;  // |k| > 3/8 n: top quarter
   }
@@ -100,8 +100,8 @@ double TwoScale::tau_roughness(const Vector& y) const {
   return total > 0.0 ? top / total : 0.0;
 }
 
-double TwoScale::tau_spread(const Vector& y) const {
-  const double total = std::pow(grid_.coefficient_norm(y), 2);
+Real TwoScale::tau_spread(const Vector& y) const {
+  const Real total = std::pow(grid_.coefficient_norm(y), 2);
   return total > 0.0 ? std::pow(grid_.coefficient_norm(y, true), 2) / total : 0.0;
 }
 

@@ -59,17 +59,17 @@ class TwoScale final : public Reformulation, public TwoScaleDiagnostics {
   static bool real_layout_for(const Model& model) { return TauGrid::real_layout_for(model); }
   const Diagonal& linear_multipliers() const override { return multipliers_; }
   const Vector& remainder_multipliers() const override { return remainder_grid_; }
-  void nonlinear(double t, const Vector& y, Vector& out) override;
-  void nonlinear_derivative(double t, const Vector& y, const Vector& dy, Vector& out) override;
-  void rhs(double t, const Vector& y, Vector& out) override;
+  void nonlinear(Real t, const Vector& y, Vector& out) override;
+  void nonlinear_derivative(Real t, const Vector& y, const Vector& dy, Vector& out) override;
+  void rhs(Real t, const Vector& y, Vector& out) override;
 
   /// Prepared initial data of the configured order (eq. 2nd data; SPEC.md for order 3).
   Vector prepare(const Vector& u0) override;
   /// u(t) = e^{JM t/eps} U(t, t/eps), U evaluated off the grid by its interpolant.
-  Vector read_back(const Vector& y, double t) override;
+  Vector read_back(const Vector& y, Real t) override;
   const TwoScaleDiagnostics* two_scale_diagnostics() const override { return this; }
-  double tau_roughness(const Vector& y) const override;
-  double tau_spread(const Vector& y) const override;
+  Real tau_roughness(const Vector& y) const override;
+  Real tau_spread(const Vector& y) const override;
   /// Re-prepares U when the rule says so: v_n = U(t_n, s_n), s_n = t_n/eps mod 2 pi, and U
   /// rebuilt as prepared data centred at s_n (U(t_n, s_n) = v_n exactly, u(t_n) unchanged).
   StateObserver* repreparation() override { return &repreparer_; }
@@ -78,7 +78,7 @@ class TwoScale final : public Reformulation, public TwoScaleDiagnostics {
   int threads() const override { return grid_.threads(); }
 
  private:
-  double eps_;
+  Real eps_;
   Vector remainder_;  // i omega per model coordinate (empty without a remainder)
   TauGrid grid_;
   PreparedData data_;

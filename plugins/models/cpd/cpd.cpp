@@ -22,6 +22,7 @@
 
 namespace {
 
+using tsi::Real;
 using tsi::Complex;
 using tsi::ConstMatrixRef;
 using tsi::Index;
@@ -36,7 +37,7 @@ class ChargedParticle final : public tsi::Model,
                               public tsi::ExactNonlinearFlow,
                               public tsi::PhysicalVariables {
  public:
-  ChargedParticle(double eps, Potential potential) : Model(eps), potential_(potential) {}
+  ChargedParticle(Real eps, Potential potential) : Model(eps), potential_(potential) {}
   using Model::linear_flow;
   using Model::nonlinear_field;
 
@@ -50,12 +51,12 @@ class ChargedParticle final : public tsi::Model,
 
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
     for (Index j = 0; j < u.cols(); ++j) {
-      const double c = std::cos(0.5 * taus(j)), s = std::sin(0.5 * taus(j));
+      const Real c = std::cos(0.5 * taus(j)), s = std::sin(0.5 * taus(j));
       // The model is real: compute with real parts (imaginary parts on the grid are rounding).
-      const double q1 = u(0, j).real(), q2 = u(1, j).real(), p1 = u(2, j).real(), p2 = u(3, j).real();
+      const Real q1 = u(0, j).real(), q2 = u(1, j).real(), p1 = u(2, j).real(), p2 = u(3, j).real();
       // a = c q + s p, b = -s q + c p, then R applied to both.
-      const double a1 = c * q1 + s * p1, a2 = c * q2 + s * p2;
-      const double b1 = -s * q1 + c * p1, b2 = -s * q2 + c * p2;
+      const Real a1 = c * q1 + s * p1, a2 = c * q2 + s * p2;
+      const Real b1 = -s * q1 + c * p1, b2 = -s * q2 + c * p2;
       u(0, j) = c * a1 + s * a2;
       u(1, j) = -s * a1 + c * a2;
       u(2, j) = c * b1 + s * b2;
@@ -66,14 +67,14 @@ class ChargedParticle final : public tsi::Model,
   // J grad H1 = (dH1/dp, -dH1/dq) = (0, -2 eps grad U(q)). Coulomb: grad U = -q / |q|^3, with
   // |q|^2 = q1^2 + q2^2 continued analytically to complex q (the derivative below matches).
   void nonlinear_field(ConstMatrixRef u, MatrixRef out) const override {
-    const double two_eps = 2.0 * eps();
+    const Real two_eps = 2.0 * eps();
     for (Index j = 0; j < u.cols(); ++j) {
-      const double q1 = u(0, j).real(), q2 = u(1, j).real();
+      const Real q1 = u(0, j).real(), q2 = u(1, j).real();
       // p' = k q. The model is real: the imaginary parts on the tau grid are rounding, so
       // everything is computed in real arithmetic (no complex sqrt or division per point).
-      double k = -two_eps;
+      Real k = -two_eps;
       if (potential_ == Potential::Coulomb) {
-        const double r2 = q1 * q1 + q2 * q2;
+        const Real r2 = q1 * q1 + q2 * q2;
         k = two_eps / (r2 * std::sqrt(r2));
       }
       out(0, j) = 0.0;
@@ -117,23 +118,23 @@ class ChargedParticle final : public tsi::Model,
   // On complex or real grids (a real model's two-scale problem keeps its tau grid real).
   template <class Grid>
   void fused_field(const tsi::RealVector& cos, const tsi::RealVector& sin, Grid& u, Grid& out) const {
-    const double two_eps = 2.0 * eps();
+    const Real two_eps = 2.0 * eps();
     constexpr Index block = 16;
-    double x1[block], x2[block], k[block];
+    Real x1[block], x2[block], k[block];
     for (Index j0 = 0; j0 < u.cols(); j0 += block) {
       const Index m = std::min(block, u.cols() - j0);
       for (Index i = 0; i < m; ++i) {
         const Index j = j0 + i;
-        const double c = cos(j), s = sin(j);
-        const double q1 = std::real(u(0, j)), q2 = std::real(u(1, j)), p1 = std::real(u(2, j)),
+        const Real c = cos(j), s = sin(j);
+        const Real q1 = std::real(u(0, j)), q2 = std::real(u(1, j)), p1 = std::real(u(2, j)),
                      p2 = std::real(u(3, j));
-        const double a1 = c * q1 + s * p1, a2 = c * q2 + s * p2;
+        const Real a1 = c * q1 + s * p1, a2 = c * q2 + s * p2;
         x1[i] = c * a1 + s * a2;  // q of e^{JM tau} u
         x2[i] = -s * a1 + c * a2;
       }
       if (potential_ == Potential::Coulomb) {
         for (Index i = 0; i < m; ++i) {
-          const double r2 = x1[i] * x1[i] + x2[i] * x2[i];
+          const Real r2 = x1[i] * x1[i] + x2[i] * x2[i];
           k[i] = two_eps / (r2 * std::sqrt(r2));
         }
       } else {
@@ -141,10 +142,10 @@ class ChargedParticle final : public tsi::Model,
       }
       for (Index i = 0; i < m; ++i) {
         const Index j = j0 + i;
-        const double c = cos(j), s = sin(j);
-        const double f1 = k[i] * x1[i], f2 = k[i] * x2[i];
+        const Real c = cos(j), s = sin(j);
+        const Real f1 = k[i] * x1[i], f2 = k[i] * x2[i];
         // linear_flow at -tau (sin -> -sin) applied to (0, 0, f1, f2).
-        const double b1 = -s * f1, b2 = -s * f2, d1 = c * f1, d2 = c * f2;
+        const Real b1 = -s * f1, b2 = -s * f2, d1 = c * f1, d2 = c * f2;
         out(0, j) = c * b1 - s * b2;
         out(1, j) = s * b1 + c * b2;
         out(2, j) = c * d1 - s * d2;
@@ -155,16 +156,16 @@ class ChargedParticle final : public tsi::Model,
 
   // D[2 eps q |q|^{-3}] z = 2 eps (z |q|^{-3} - 3 q (q . z) |q|^{-5}).
   void nonlinear_field_derivative(ConstMatrixRef u, ConstMatrixRef z, MatrixRef out) const override {
-    const double two_eps = 2.0 * eps();
+    const Real two_eps = 2.0 * eps();
     for (Index j = 0; j < u.cols(); ++j) {
       const Complex q1 = u(0, j), q2 = u(1, j), z1 = z(0, j), z2 = z(1, j);
       out(0, j) = 0.0;
       out(1, j) = 0.0;
       if (potential_ == Potential::Coulomb) {
         const Complex r2 = q1 * q1 + q2 * q2;
-        const Complex inv3 = 1.0 / (r2 * std::sqrt(r2)), qz = q1 * z1 + q2 * z2;
-        out(2, j) = two_eps * (z1 * inv3 - 3.0 * q1 * qz * inv3 / r2);
-        out(3, j) = two_eps * (z2 * inv3 - 3.0 * q2 * qz * inv3 / r2);
+        const Complex inv3 = Real(1) / (r2 * std::sqrt(r2)), qz = q1 * z1 + q2 * z2;
+        out(2, j) = two_eps * (z1 * inv3 - Real(3) * q1 * qz * inv3 / r2);
+        out(3, j) = two_eps * (z2 * inv3 - Real(3) * q2 * qz * inv3 / r2);
       } else {
         out(2, j) = -two_eps * z1;
         out(3, j) = -two_eps * z2;
@@ -176,7 +177,7 @@ class ChargedParticle final : public tsi::Model,
   void apply_M(const Vector& u, Vector& out) const override {
     const Complex q1 = u(0), q2 = u(1), p1 = u(2), p2 = u(3);
     out.resize(4);
-    out << 0.5 * (q1 - p2), 0.5 * (q2 + p1), 0.5 * (q2 + p1), 0.5 * (-q1 + p2);
+    out << Real(0.5) * (q1 - p2), Real(0.5) * (q2 + p1), Real(0.5) * (q2 + p1), Real(0.5) * (-q1 + p2);
   }
 
   void apply_J(const Vector& u, Vector& out) const override {
@@ -184,10 +185,10 @@ class ChargedParticle final : public tsi::Model,
     out << u(2), u(3), -u(0), -u(1);
   }
 
-  double H1(const Vector& u) const override { return 2.0 * eps() * potential(u(0).real(), u(1).real()); }
+  Real H1(const Vector& u) const override { return 2.0 * eps() * potential(u(0).real(), u(1).real()); }
 
   // q' = 0, p' = -2 eps grad U(q): q fixed, p moves linearly in t.
-  void nonlinear_flow(double t, Vector& u) const override {
+  void nonlinear_flow(Real t, Vector& u) const override {
     Vector field = nonlinear_field(u);
     u(2) += t * field(2);
     u(3) += t * field(3);
@@ -200,16 +201,16 @@ class ChargedParticle final : public tsi::Model,
   // An adiabatic invariant: w' = (1/eps) B w - eps B Dg(x) v, whose second term averages to zero
   // over a gyration (B Dg is traceless), so mu oscillates by O(eps^2) relative and does not drift.
   // Without the drift, eps |v|^2 / 2 = I / 2 exactly, which oscillates by O(eps) (err_I).
-  double magnetic_moment(const Vector& u) const {
-    const double q1 = u(0).real(), q2 = u(1).real(), p1 = u(2).real(), p2 = u(3).real();
-    double g1 = -q1, g2 = -q2;  // g = -grad U
+  Real magnetic_moment(const Vector& u) const {
+    const Real q1 = u(0).real(), q2 = u(1).real(), p1 = u(2).real(), p2 = u(3).real();
+    Real g1 = -q1, g2 = -q2;  // g = -grad U
     if (potential_ == Potential::Coulomb) {
-      const double r2 = q1 * q1 + q2 * q2, k = 1.0 / (r2 * std::sqrt(r2));
+      const Real r2 = q1 * q1 + q2 * q2, k = 1.0 / (r2 * std::sqrt(r2));
       g1 = k * q1;
       g2 = k * q2;
     }
-    const double drift = 2.0 * eps() * eps();  // B (a, b) = (b, -a)
-    const double a1 = p1 + q2 - drift * g2, a2 = p2 - q1 + drift * g1;
+    const Real drift = 2.0 * eps() * eps();  // B (a, b) = (b, -a)
+    const Real a1 = p1 + q2 - drift * g2, a2 = p2 - q1 + drift * g1;
     return (a1 * a1 + a2 * a2) / (8.0 * eps());
   }
 
@@ -238,14 +239,14 @@ class ChargedParticle final : public tsi::Model,
   // (q, p) -> (x, v) = (q, (p + B q) / (2 eps)).
   Vector to_physical(const Vector& u) const override {
     Vector x(4);
-    const double inv = 1.0 / (2.0 * eps());
+    const Real inv = 1.0 / (2.0 * eps());
     x << u(0), u(1), (u(2) + u(1)) * inv, (u(3) - u(0)) * inv;
     return x;
   }
 
  private:
-  double potential(double x1, double x2) const {
-    const double r2 = x1 * x1 + x2 * x2;
+  Real potential(Real x1, Real x2) const {
+    const Real r2 = x1 * x1 + x2 * x2;
     return potential_ == Potential::Coulomb ? 1.0 / std::sqrt(r2) : 0.5 * r2;
   }
 

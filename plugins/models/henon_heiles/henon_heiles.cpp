@@ -13,11 +13,12 @@ using tsi::Complex;
 using tsi::ConstMatrixRef;
 using tsi::Index;
 using tsi::MatrixRef;
+using tsi::Real;
 using tsi::Vector;
 
 class HenonHeiles final : public tsi::Model, public tsi::HamiltonianStructure, public tsi::FusedTauGrid {
  public:
-  explicit HenonHeiles(double eps) : Model(eps) {}
+  explicit HenonHeiles(Real eps) : Model(eps) {}
 
   const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
   const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
@@ -30,8 +31,8 @@ class HenonHeiles final : public tsi::Model, public tsi::HamiltonianStructure, p
   // parts, which halves their cost against complex arithmetic.
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
     for (Index j = 0; j < u.cols(); ++j) {
-      const double c = std::cos(taus(j)), s = std::sin(taus(j));
-      const double q1 = u(0, j).real(), p1 = u(2, j).real();
+      const Real c = std::cos(taus(j)), s = std::sin(taus(j));
+      const Real q1 = u(0, j).real(), p1 = u(2, j).real();
       u(0, j) = c * q1 + s * p1;
       u(2, j) = -s * q1 + c * p1;
     }
@@ -40,7 +41,7 @@ class HenonHeiles final : public tsi::Model, public tsi::HamiltonianStructure, p
   // J grad H1 = (dH1/dp, -dH1/dq).
   void nonlinear_field(ConstMatrixRef u, MatrixRef out) const override {
     for (Index j = 0; j < u.cols(); ++j) {
-      const double q1 = u(0, j).real(), q2 = u(1, j).real(), p2 = u(3, j).real();
+      const Real q1 = u(0, j).real(), q2 = u(1, j).real(), p2 = u(3, j).real();
       out(0, j) = 0.0;
       out(1, j) = p2;
       out(2, j) = -2.0 * q1 * q2;
@@ -78,10 +79,10 @@ class HenonHeiles final : public tsi::Model, public tsi::HamiltonianStructure, p
   template <class Grid>
   static void fused_field(const tsi::RealVector& cos, const tsi::RealVector& sin, Grid& u, Grid& out) {
     for (Index j = 0; j < u.cols(); ++j) {
-      const double c = cos(j), s = sin(j);
-      const double q1 = c * std::real(u(0, j)) + s * std::real(u(2, j)), q2 = std::real(u(1, j)),
+      const Real c = cos(j), s = sin(j);
+      const Real q1 = c * std::real(u(0, j)) + s * std::real(u(2, j)), q2 = std::real(u(1, j)),
                    p2 = std::real(u(3, j));
-      const double g = -2.0 * q1 * q2;
+      const Real g = -2.0 * q1 * q2;
       out(0, j) = -s * g;
       out(1, j) = p2;
       out(2, j) = c * g;
@@ -95,8 +96,8 @@ class HenonHeiles final : public tsi::Model, public tsi::HamiltonianStructure, p
       const Complex a = z(0, j), b = z(1, j), d = z(3, j);
       out(0, j) = 0.0;
       out(1, j) = d;
-      out(2, j) = -2.0 * (a * q2 + q1 * b);
-      out(3, j) = -b - 2.0 * q1 * a + 2.0 * q2 * b;
+      out(2, j) = Real(-2) * (a * q2 + q1 * b);
+      out(3, j) = -b - Real(2) * q1 * a + Real(2) * q2 * b;
     }
   }
 
@@ -110,8 +111,8 @@ class HenonHeiles final : public tsi::Model, public tsi::HamiltonianStructure, p
     out << u(2), u(3), -u(0), -u(1);
   }
 
-  double H1(const Vector& u) const override {
-    const double q1 = u(0).real(), q2 = u(1).real(), p2 = u(3).real();
+  Real H1(const Vector& u) const override {
+    const Real q1 = u(0).real(), q2 = u(1).real(), p2 = u(3).real();
     return 0.5 * q2 * q2 + 0.5 * p2 * p2 + q1 * q1 * q2 - q2 * q2 * q2 / 3.0;
   }
 

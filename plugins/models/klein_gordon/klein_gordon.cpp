@@ -65,6 +65,7 @@
 
 namespace {
 
+using tsi::Real;
 using tsi::Complex;
 using tsi::ConstMatrixRef;
 using tsi::Index;
@@ -88,7 +89,7 @@ class KleinGordon final : public tsi::Model,
  public:
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
   // wave: the plane wave of model.initial = "plane-wave", else none (the default data).
-  KleinGordon(double eps, std::vector<int> shape, double lambda, std::optional<tsi::PlaneWave> wave,
+  KleinGordon(Real eps, std::vector<int> shape, Real lambda, std::optional<tsi::PlaneWave> wave,
               tsi::ThreadLimit fftw_threads = {})
       : Model(eps),
         grid_(std::move(shape)),
@@ -103,8 +104,8 @@ class KleinGordon final : public tsi::Model,
         half_to_full_(grid_.half_to_full()),
         batches_(grid_, fftw_threads) {
     for (Index j = 0; j < n_x_; ++j) {
-      const double k2 = grid_.laplacian_symbol()(j);  // |k|^2, the Nyquist index as +n/2
-      const double root = std::sqrt(1.0 + eps * k2);
+      const Real k2 = grid_.laplacian_symbol()(j);  // |k|^2, the Nyquist index as +n/2
+      const Real root = std::sqrt(1.0 + eps * k2);
       inverse_a_(j) = 1.0 / std::sqrt(root);
       remainder_(j) = k2 / (1.0 + root);
     }
@@ -125,7 +126,7 @@ class KleinGordon final : public tsi::Model,
 
   // e^{JM tau} = e^{i tau}: one phase for every coordinate.
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
-    for (Index j = 0; j < u.cols(); ++j) u.col(j) *= std::polar(1.0, taus(j));
+    for (Index j = 0; j < u.cols(); ++j) u.col(j) *= std::polar(Real(1), taus(j));
   }
 
   // i lambda sqrt(2 pi) / n_x a^{-1} forward(z^3), z = Re backward(a^{-1} c) / sqrt(2 pi).
@@ -177,7 +178,7 @@ class KleinGordon final : public tsi::Model,
     b.backward();
     // backward(a^{-1} c) = (2 pi)^{d/2} g; z^3 is Re(.)^3 / (2 pi)^{3d/2}, and the field's factor
     // (2 pi)^{d/2} / N: lambda Re(.)^3 / ((2 pi)^d N), real, before the forward transform.
-    const double scale = lambda_ / (volume_ * point_count());
+    const Real scale = lambda_ / (volume_ * point_count());
     auto z = b.values();
     z = scale * z.array().cube().matrix();
     b.forward();
@@ -201,7 +202,7 @@ class KleinGordon final : public tsi::Model,
     z = b.values();
     for (Index j = 0; j < cols; ++j) hermitian_part(d.col(j), false, one, b.spectrum().col(j));
     b.backward();
-    const double scale = 3.0 * lambda_ / (volume_ * point_count());
+    const Real scale = 3.0 * lambda_ / (volume_ * point_count());
     auto dz = b.values();
     dz = (scale * z.array().square() * dz.array()).matrix();
     b.forward();
@@ -212,7 +213,7 @@ class KleinGordon final : public tsi::Model,
   void apply_J(const Vector& u, Vector& out) const override { out = Complex(0.0, 1.0) * u; }
 
   // (lambda / 4) (2 pi / n_x) sum z_j^4 with z_j = Re backward(a^{-1} c)_j / sqrt(2 pi).
-  double H1(const Vector& c) const override {
+  Real H1(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
     tsi::RealGridTransforms& b = real_batch(1);
     hermitian_part(c, false, Complex(1.0, 0.0), b.spectrum().col(0));
@@ -223,7 +224,7 @@ class KleinGordon final : public tsi::Model,
   const tsi::RealVector& linear_remainder() const override { return remainder_; }
 
   // z is constant along u' = J grad H1 (the field only moves p), so the field is too.
-  void nonlinear_flow(double t, Vector& c) const override {
+  void nonlinear_flow(Real t, Vector& c) const override {
     const Vector field = nonlinear_field(c);
     c += t * field;
   }
@@ -231,14 +232,14 @@ class KleinGordon final : public tsi::Model,
   // v0(x) = cos x / (1 + sin^2 x) - (i/2) sin x / (1 + cos^2 x) (see the header).
   Vector initial_value() const override {
     Vector v(n_x_);
-    grid_.for_each_point([&](Index j, const std::array<double, 3>& x) {
+    grid_.for_each_point([&](Index j, const std::array<Real, 3>& x) {
       if (wave_) {
         v(j) = wave_->at(x);
         return;
       }
-      double z = 1.0, p = 1.0;  // the products over the directions
+      Real z = 1.0, p = 1.0;  // the products over the directions
       for (int i = 0; i < grid_.dims(); ++i) {
-        const double s = std::sin(x[static_cast<std::size_t>(i)]), co = std::cos(x[static_cast<std::size_t>(i)]);
+        const Real s = std::sin(x[static_cast<std::size_t>(i)]), co = std::cos(x[static_cast<std::size_t>(i)]);
         z = i ? z * (co / (1.0 + s * s)) : co / (1.0 + s * s);
         p = i ? p * (s / (1.0 + co * co)) : s / (1.0 + co * co);
       }
@@ -250,14 +251,14 @@ class KleinGordon final : public tsi::Model,
   // At lambda = 0 every mode turns alone, w_k' = i omega_k w_k with omega_k even in k, so the
   // plane wave v0 = a e^{i k.x} (z = a cos k.x, a wave moving against k) is v0 e^{i omega_k t},
   // omega_k = sqrt(1 + eps |k|^2) / eps. x0 must be that wave (model.u0 not given).
-  tsi::ExactSolution::Value at(const Vector& x0, double t) const override {
+  tsi::ExactSolution::Value at(const Vector& x0, Real t) const override {
     const Vector wave = to_physical(initial_value());
-    if ((x0 - wave).norm() > 1e-13 * std::max(1.0, wave.norm()))
+    if ((x0 - wave).norm() > 1e-13 * std::max<Real>(1, wave.norm()))
       throw tsi::Error("klein-gordon: the exact solution is the plane wave of model.initial = \"plane-wave\"; this "
                        "run starts elsewhere (model.u0 given)");
-    const double omega = std::sqrt(1.0 + eps() * wave_->k2()) / eps();
-    const double rounding = std::numeric_limits<double>::epsilon();
-    return {x0 * std::polar(1.0, omega * t), std::max(rounding, 4.0 * rounding * std::abs(omega * t))};
+    const Real omega = std::sqrt(1.0 + eps() * wave_->k2()) / eps();
+    const Real rounding = std::numeric_limits<Real>::epsilon();
+    return {x0 * std::polar(Real(1), omega * t), std::max(rounding, 4.0 * rounding * std::abs(omega * t))};
   }
 
   Index physical_dim() const override { return n_x_; }
@@ -287,7 +288,7 @@ class KleinGordon final : public tsi::Model,
   }
 
   // Discrete L2 norm of grid samples.
-  double error_norm(const Vector& v) const override { return std::sqrt(volume_ / point_count()) * v.norm(); }
+  Real error_norm(const Vector& v) const override { return std::sqrt(volume_ / point_count()) * v.norm(); }
 
  private:
   // The transforms for batches of `columns` states, planned on first use and kept. Callers
@@ -313,7 +314,7 @@ class KleinGordon final : public tsi::Model,
         y = times(y, turn);
         y_minus = times(y_minus, turn);
       }
-      half(q) = 0.5 * (y + std::conj(y_minus));
+      half(q) = Real(0.5) * (y + std::conj(y_minus));
     }
   }
 
@@ -327,7 +328,7 @@ class KleinGordon final : public tsi::Model,
       out(m) = inverse_a_(m) * times(f, turn);
     }
   }
-  double point_count() const { return static_cast<double>(n_x_); }
+  Real point_count() const { return static_cast<Real>(n_x_); }
 
   // a b, written out: std::complex's operator* tests every product for inf/NaN.
   static Complex times(Complex a, Complex b) {
@@ -337,8 +338,8 @@ class KleinGordon final : public tsi::Model,
   tsi::SpectralGrid grid_;
   Index n_x_;       // the grid's points, N
   std::optional<tsi::PlaneWave> wave_;
-  double lambda_;
-  double volume_;   // (2 pi)^d
+  Real lambda_;
+  Real volume_;   // (2 pi)^d
   tsi::RealVector inverse_a_;  // a_k^{-1} = (1 + eps k^2)^{-1/4}
   tsi::RealVector remainder_;  // A_k = k^2 / (1 + sqrt(1 + eps k^2))
   mutable std::mutex mutex_;   // the batches' buffers are shared work space
@@ -362,7 +363,7 @@ void register_klein_gordon(tsi::Registry& registry) {
     entry.info.params.push_back(std::move(spec));
   entry.info.params.push_back(
       tsi::number_param("lambda", 1.0, "coefficient of the cubic term lambda z^3")
-          .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number"));
+          .check([](const tsi::Json& v) { return std::isfinite(v.get<Real>()); }, "a finite number"));
   entry.default_n_tau = 32;
   entry.nonlinearity_degree = 3;
   // From h = 1/16: coarser steps are pre-asymptotic for the modes 3, 5, 7 of the default u0

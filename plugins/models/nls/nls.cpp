@@ -44,6 +44,7 @@
 
 namespace {
 
+using tsi::Real;
 using tsi::Complex;
 using tsi::ConstMatrixRef;
 using tsi::Index;
@@ -64,7 +65,7 @@ Complex times_conj(Complex a, Complex b) {
 // e^{-i m^2 tau} for m = 1, 2, ... in turn, by phase_table's recurrence (the same products).
 class PhaseRecurrence {
  public:
-  explicit PhaseRecurrence(double tau) : z_(std::polar(1.0, -tau)), z2_(z_ * z_), factor_(z_) {}
+  explicit PhaseRecurrence(Real tau) : z_(std::polar(Real(1), -tau)), z2_(z_ * z_), factor_(z_) {}
   Complex next() {
     phase_ *= factor_;
     factor_ *= z2_;
@@ -96,7 +97,7 @@ class Phases {
     for (int i = 0; i < grid.dims(); ++i)
       per_direction_[static_cast<std::size_t>(i)].resize(grid.shape()[static_cast<std::size_t>(i)] / 2 + 1);
   }
-  void set(double tau, const PhaseTables* tables, Index column) {
+  void set(Real tau, const PhaseTables* tables, Index column) {
     for (int i = 0; i < grid_.dims(); ++i) {
       Vector& phase = per_direction_[static_cast<std::size_t>(i)];
       if (tables) {
@@ -144,7 +145,7 @@ class Nls final : public tsi::Model,
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
   // dealias: the 2/3 rule on the field (and on u0), see the header.
   // wave: the plane wave of model.initial = "plane-wave", else none (the paper's data).
-  Nls(double eps, std::vector<int> shape, std::optional<tsi::PlaneWave> wave, bool dealias,
+  Nls(Real eps, std::vector<int> shape, std::optional<tsi::PlaneWave> wave, bool dealias,
       tsi::ThreadLimit fftw_threads = {})
       : Model(eps),
         grid_(std::move(shape)),
@@ -245,7 +246,7 @@ class Nls final : public tsi::Model,
   // it is written: out may be c.
   void fused_field(const tsi::RealVector& taus, const PhaseTables* tables, Phases& phases, tsi::GridTransforms& b,
                    MatrixRef c, MatrixRef out) const {
-    const double scale = 1.0 / (volume_ * point_count());
+    const Real scale = 1.0 / (volume_ * point_count());
     for (Index j0 = 0; j0 < c.cols(); j0 += b.columns()) {
       const Index k = std::min(b.columns(), c.cols() - j0);
       auto w = b.data();  // column j: state j0 + j
@@ -255,9 +256,9 @@ class Nls final : public tsi::Model,
       }
       if (k < w.cols()) w.rightCols(w.cols() - k).setZero();
       b.backward();
-      double* q = reinterpret_cast<double*>(w.data());
+      Real* q = reinterpret_cast<Real*>(w.data());
       for (Index i = 0; i < 2 * w.size(); i += 2) {
-        const double re = q[i], im = q[i + 1], a = scale * (re * re + im * im);
+        const Real re = q[i], im = q[i + 1], a = scale * (re * re + im * im);
         q[i] = a * im;
         q[i + 1] = -a * re;
       }
@@ -308,7 +309,7 @@ class Nls final : public tsi::Model,
   void apply_J(const Vector& u, Vector& out) const override { out = Complex(0.0, -0.5) * u; }
 
   // (1/2) ||u||_{L4}^4 = (1/2) ((2 pi)^d / N) sum |u_j|^4 = sum |w_j|^4 / (2 (2 pi)^d N).
-  double H1(const Vector& c) const override {
+  Real H1(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
     tsi::GridTransforms& b = batch(1);
     auto w = b.data();
@@ -326,11 +327,11 @@ class Nls final : public tsi::Model,
   // change 2.9e-5 .. 3.7e-5 over t = 1 (eps = 0.01 .. 1) and 2.3e-4 over t = 10 at n_x = 16,
   // 7.8e-10 over t = 10 at n_x = 32, and from n_x = 64 no more than H changes (1e-15 .. 4e-14
   // over t = 1: the rounding of rk78's steps).
-  double momentum(int direction, const Vector& c) const {
+  Real momentum(int direction, const Vector& c) const {
     const int n = grid_.shape()[static_cast<std::size_t>(direction)];
     Index stride = 1;  // C order: the last direction's index runs fastest
     for (int i = direction + 1; i < grid_.dims(); ++i) stride *= grid_.shape()[static_cast<std::size_t>(i)];
-    double p = 0.0;
+    Real p = 0.0;
     for (Index q = 0; q < c.size(); ++q) {
       const int j = static_cast<int>((q / stride) % n);
       if (2 * j != n) p += grid_.wave_number(direction, j) * std::norm(c(q));
@@ -356,25 +357,25 @@ class Nls final : public tsi::Model,
   }
 
   // The fastest mode turns with e^{-i |m|^2 tau}, |m|^2 = sum (n_i/2)^2.
-  double max_linear_frequency() const override { return grid_.max_laplacian_symbol(); }
+  double max_linear_frequency() const override { return tsi::to_double(grid_.max_laplacian_symbol()); }
 
   // u' = -i |u|^2 u keeps |u| fixed pointwise: u -> u e^{-i |u|^2 t} on the grid.
-  void nonlinear_flow(double t, Vector& c) const override {
+  void nonlinear_flow(Real t, Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
     tsi::GridTransforms& b = batch(1);
     auto w = b.data();
     w.col(0) = c;
     b.backward();
-    const double to_u2 = 1.0 / volume_;  // |u|^2 = |w|^2 / (2 pi)^d
-    const double points = static_cast<double>(grid_.points());
-    for (Index i = 0; i < w.rows(); ++i) w(i, 0) *= std::polar(1.0 / points, -t * std::norm(w(i, 0)) * to_u2);
+    const Real to_u2 = 1.0 / volume_;  // |u|^2 = |w|^2 / (2 pi)^d
+    const Real points = static_cast<Real>(grid_.points());
+    for (Index i = 0; i < w.rows(); ++i) w(i, 0) *= std::polar(Real(1) / points, -t * std::norm(w(i, 0)) * to_u2);
     b.forward();
     c = w.col(0);
   }
 
   Vector initial_value() const override {
     Vector x(grid_.points());
-    grid_.for_each_point([&](Index p, const std::array<double, 3>& at) {
+    grid_.for_each_point([&](Index p, const std::array<Real, 3>& at) {
       if (wave_) {
         x(p) = wave_->at(at);
         return;
@@ -389,15 +390,15 @@ class Nls final : public tsi::Model,
 
   // The plane wave a e^{i k.x} e^{-i (|k|^2/eps + a^2) t}: x0 times the phase, where x0 is that
   // wave (a run from another model.u0 has no exact solution: an error names it).
-  tsi::ExactSolution::Value at(const Vector& x0, double t) const override {
+  tsi::ExactSolution::Value at(const Vector& x0, Real t) const override {
     const Vector wave = to_physical(initial_value());
-    if ((x0 - wave).norm() > 1e-13 * std::max(1.0, wave.norm()))
+    if ((x0 - wave).norm() > 1e-13 * std::max<Real>(1, wave.norm()))
       throw tsi::Error("nls: the exact solution is the plane wave of model.initial = \"plane-wave\"; this run "
                        "starts elsewhere (model.u0 given)");
-    const double frequency = wave_->k2() / eps() + wave_->amplitude * wave_->amplitude;
+    const Real frequency = wave_->k2() / eps() + wave_->amplitude * wave_->amplitude;
     // The phase is rounded to a few ulp of frequency * t, as the schemes' own e^{-i |m|^2 t / eps}.
-    const double rounding = std::numeric_limits<double>::epsilon();
-    return {x0 * std::polar(1.0, -frequency * t), std::max(rounding, 4.0 * rounding * std::abs(frequency * t))};
+    const Real rounding = std::numeric_limits<Real>::epsilon();
+    return {x0 * std::polar(Real(1), -frequency * t), std::max(rounding, 4.0 * rounding * std::abs(frequency * t))};
   }
 
   Index physical_dim() const override { return grid_.points(); }
@@ -413,7 +414,7 @@ class Nls final : public tsi::Model,
     auto w = b.data();
     w.col(0) = x;
     b.forward();
-    Vector c = w.col(0) * (std::sqrt(volume_) / static_cast<double>(grid_.points()));
+    Vector c = w.col(0) * (std::sqrt(volume_) / static_cast<Real>(grid_.points()));
     dealias(c);
     return c;
   }
@@ -429,8 +430,8 @@ class Nls final : public tsi::Model,
   }
 
   // Discrete L2 norm of grid samples.
-  double error_norm(const Vector& x) const override {
-    return std::sqrt(volume_ / static_cast<double>(grid_.points())) * x.norm();
+  Real error_norm(const Vector& x) const override {
+    return std::sqrt(volume_ / static_cast<Real>(grid_.points())) * x.norm();
   }
 
  private:
@@ -450,7 +451,7 @@ class Nls final : public tsi::Model,
     return std::min({columns, slice_columns, std::max<Index>(1, slice_values / grid_.points())});
   }
 
-  double point_count() const { return static_cast<double>(grid_.points()); }
+  Real point_count() const { return static_cast<Real>(grid_.points()); }
 
   // With the 2/3 rule, the modes outside its band set to zero (columns of coefficients).
   template <class Columns>
@@ -459,15 +460,15 @@ class Nls final : public tsi::Model,
       for (Index j = 0; j < c.cols(); ++j) c.col(j).array() *= dealias_.array();
   }
 
-  static Complex paper_profile(double x) {
-    const double s = std::sin(x);
-    return std::polar(1.0, x) / (1.0 + s * s);
+  static Complex paper_profile(Real x) {
+    const Real s = std::sin(x);
+    return std::polar(Real(1), x) / (1.0 + s * s);
   }
 
   tsi::SpectralGrid grid_;
   std::optional<tsi::PlaneWave> wave_;
   tsi::RealVector dealias_;    // the 2/3 rule's mask, or empty
-  double volume_;              // (2 pi)^d
+  Real volume_;              // (2 pi)^d
   mutable std::mutex mutex_;   // the batches' buffers and phases_ are shared work space
   mutable tsi::GridTransformsPool batches_;
   mutable Phases phases_{grid_};

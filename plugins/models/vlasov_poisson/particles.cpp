@@ -13,18 +13,18 @@
 namespace tsi::pic {
 namespace {
 
-// A double in [0, 1) from the generator's top 53 bits: the same on every platform
+// A Real in [0, 1) from the generator's top 53 bits: the same on every platform
 // (std::uniform_real_distribution and std::generate_canonical are not specified that far).
-double uniform(std::mt19937_64& gen) { return static_cast<double>(gen() >> 11) * 0x1.0p-53; }
+Real uniform(std::mt19937_64& gen) { return static_cast<Real>(gen() >> 11) * 0x1.0p-53; }
 
 }  // namespace
 
-RealVector sample_particles(const Geometry& g, Distribution distribution, double alpha, std::uint64_t seed) {
+RealVector sample_particles(const Geometry& g, Distribution distribution, Real alpha, std::uint64_t seed) {
   std::mt19937_64 gen(seed);
   RealVector u(4 * g.particles);
-  const double lx = g.length_x(), ly = g.length_y();
+  const Real lx = g.length_x(), ly = g.length_y();
   for (Index k = 0; k < g.particles; ++k) {
-    double x1 = 0.0, x2 = 0.0;
+    Real x1 = 0.0, x2 = 0.0;
     if (distribution == Distribution::landau) {
       for (;;) {  // x1 by rejection under 1 + alpha, x2 uniform
         x1 = uniform(gen) * lx;
@@ -38,16 +38,16 @@ RealVector sample_particles(const Geometry& g, Distribution distribution, double
         if (uniform(gen) * (2.0 + alpha) <= 1.0 + std::sin(x2) + alpha * std::cos(g.k_x * x1)) break;
       }
     }
-    double v1 = 0.0, v2 = 0.0;
+    Real v1 = 0.0, v2 = 0.0;
     if (distribution == Distribution::landau) {  // Box-Muller
-      const double r = std::sqrt(-2.0 * std::log(1.0 - uniform(gen))), theta = two_pi * uniform(gen);
+      const Real r = std::sqrt(-2.0 * std::log(1.0 - uniform(gen))), theta = two_pi * uniform(gen);
       v1 = r * std::cos(theta);
       v2 = r * std::sin(theta);
     } else {
       for (;;) {
         v1 = (uniform(gen) - 0.5) * 10.0;
         v2 = (uniform(gen) - 0.5) * 10.0;
-        const double f = 0.5 * (std::exp(-((v1 - 2.0) * (v1 - 2.0) + v2 * v2) / 2.0) +
+        const Real f = 0.5 * (std::exp(-((v1 - 2.0) * (v1 - 2.0) + v2 * v2) / 2.0) +
                                 std::exp(-((v1 + 2.0) * (v1 + 2.0) + v2 * v2) / 2.0));
         if (uniform(gen) <= f) break;
       }
@@ -85,10 +85,11 @@ RealVector read_particles(const std::string& file) {
                    "a NumPy file must end in .npy)");
     if (bytes / 32 > (std::uintmax_t{1} << 28))
       throw refuse(std::to_string(bytes / 32) + " particles, expected at most 2^28");
-    u.resize(static_cast<Index>(bytes / 8));
+    Eigen::VectorXd raw(static_cast<Index>(bytes / 8));  // float64 on disk, whatever Real is
     std::ifstream in(file, std::ios::binary);
-    if (!in.read(reinterpret_cast<char*>(u.data()), static_cast<std::streamsize>(bytes)))
+    if (!in.read(reinterpret_cast<char*>(raw.data()), static_cast<std::streamsize>(bytes)))
       throw refuse("cannot read it");
+    u = raw.cast<Real>();
   }
   if (u.size() / 4 > (Index{1} << 28)) throw refuse(std::to_string(u.size() / 4) + " particles, expected at most 2^28");
   static constexpr const char* names[4] = {"x1", "x2", "v1", "v2"};
@@ -102,10 +103,10 @@ RealVector read_particles(const std::string& file) {
 }
 
 void check_positions(const RealVector& u, const Geometry& geometry, const std::string& file) {
-  const double lengths[2] = {geometry.length_x(), geometry.length_y()};
+  const Real lengths[2] = {geometry.length_x(), geometry.length_y()};
   for (Index k = 0; k < u.size() / 4; ++k)
     for (int c = 0; c < 2; ++c) {
-      const double x = u(4 * k + c), length = lengths[c];
+      const Real x = u(4 * k + c), length = lengths[c];
       if (x >= -length && x < 2.0 * length) continue;
       std::ostringstream what;
       what.precision(17);

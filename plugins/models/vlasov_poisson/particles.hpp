@@ -18,7 +18,7 @@ enum class Distribution {
 /// N particles (x1, x2, v1, v2) at entries 4k .. 4k + 3 of a real vector, by rejection from
 /// the distribution with a 64-bit Mersenne twister seeded with `seed` (the same particles on
 /// every machine with IEEE doubles and a correctly rounded libm).
-RealVector sample_particles(const Geometry& geometry, Distribution distribution, double alpha, std::uint64_t seed);
+RealVector sample_particles(const Geometry& geometry, Distribution distribution, Real alpha, std::uint64_t seed);
 
 /// The particles of a file: `.npy` (float64, N x 4 or 4N values), any other name the peer's
 /// raw layout (a multiple of 32 bytes). A tsi::ConfigError naming model.particles for a file

@@ -7,8 +7,8 @@
 namespace tsi::pic {
 namespace {
 
-double fifth(double z) {
-  const double z2 = z * z;
+Real fifth(Real z) {
+  const Real z2 = z * z;
   return z2 * z2 * z;
 }
 
@@ -16,15 +16,15 @@ double fifth(double z) {
 // cell: M6 (the quintic B-spline, as the peer writes it, at distances 2 + d, 1 + d, d, 1 - d,
 // 2 - d, 3 - d) or CIC. Branch-free: the same arithmetic for every particle.
 template <int W>
-void weights(double d, double* w) {
+void weights(Real d, Real* w) {
   if constexpr (W == 2) {
     w[0] = 1.0 - d;
     w[1] = d;
   } else {
     static_assert(W == 6);
-    constexpr double c = 1.0 / 120.0;
-    const double a = 1.0 - d;
-    const double a5 = fifth(a), d5 = fifth(d), a1 = fifth(1.0 + a), d1 = fifth(1.0 + d);
+    constexpr Real c = 1.0 / 120.0;
+    const Real a = 1.0 - d;
+    const Real a5 = fifth(a), d5 = fifth(d), a1 = fifth(1.0 + a), d1 = fifth(1.0 + d);
     w[0] = a5 * c;
     w[1] = (a1 - 6.0 * a5) * c;
     w[2] = (fifth(2.0 + a) - 6.0 * a1 + 15.0 * a5) * c;
@@ -36,9 +36,9 @@ void weights(double d, double* w) {
 
 // The cell of coordinate x (x / h = cell + d, d in [0, 1)), wrapped into 0 .. n - 1. A
 // coordinate that is not finite gets cell 0 and d NaN: its weights, and so E, are NaN too.
-int cell(double x, double inverse_h, int n, double& d) {
-  const double p = x * inverse_h;
-  double i = std::floor(p);
+int cell(Real x, Real inverse_h, int n, Real& d) {
+  const Real p = x * inverse_h;
+  Real i = std::floor(p);
   d = p - i;
   if (!(i >= 0.0 && i < n)) {
     i -= n * std::floor(i / n);
@@ -51,13 +51,13 @@ int cell(double x, double inverse_h, int n, double& d) {
 
 struct Located {
   Index origin;  // the padded index of the stencil's first node
-  double wx[6], wy[6];
+  Real wx[6], wy[6];
 };
 
 template <int W>
-Located locate(double x1, double x2, double inverse_dx, double inverse_dy, int n_x, int n_y, Index padded_x) {
+Located locate(Real x1, Real x2, Real inverse_dx, Real inverse_dy, int n_x, int n_y, Index padded_x) {
   Located l;
-  double d1 = 0.0, d2 = 0.0;
+  Real d1 = 0.0, d2 = 0.0;
   const int i = cell(x1, inverse_dx, n_x, d1), j = cell(x2, inverse_dy, n_y, d2);
   weights<W>(d1, l.wx);
   weights<W>(d2, l.wy);
@@ -66,15 +66,15 @@ Located locate(double x1, double x2, double inverse_dx, double inverse_dy, int n
 }
 
 template <int W>
-void deposit_all(const double* base, ParticleLayout layout, Index particles, double w, double inverse_dx,
-                 double inverse_dy, int n_x, int n_y, Index padded_x, double* rho) {
+void deposit_all(const Real* base, ParticleLayout layout, Index particles, Real w, Real inverse_dx,
+                 Real inverse_dy, int n_x, int n_y, Index padded_x, Real* rho) {
   const Index ps = layout.particle_stride, cs = layout.component_stride;
   for (Index k = 0; k < particles; ++k) {
-    const double* p = base + k * ps;
+    const Real* p = base + k * ps;
     const Located l = locate<W>(p[0], p[cs], inverse_dx, inverse_dy, n_x, n_y, padded_x);
     for (int b = 0; b < W; ++b) {
-      double* row = rho + l.origin + b * padded_x;
-      const double s = w * l.wy[b];
+      Real* row = rho + l.origin + b * padded_x;
+      const Real s = w * l.wy[b];
       for (int a = 0; a < W; ++a) row[a] += s * l.wx[a];
     }
   }
@@ -84,14 +84,14 @@ void deposit_all(const double* base, ParticleLayout layout, Index particles, dou
 // 2 W contiguous values, summed with the y weights first (one multiply-add per value, over
 // pairs: the compiler keeps them in vector registers), then with the x weights.
 template <int W>
-void interpolate(const Located& l, const double* e, Index padded_x, double& out1, double& out2) {
-  double acc[2 * W] = {};
+void interpolate(const Located& l, const Real* e, Index padded_x, Real& out1, Real& out2) {
+  Real acc[2 * W] = {};
   for (int b = 0; b < W; ++b) {
-    const double* row = e + 2 * (l.origin + b * padded_x);
-    const double wy = l.wy[b];
+    const Real* row = e + 2 * (l.origin + b * padded_x);
+    const Real wy = l.wy[b];
     for (int a = 0; a < 2 * W; ++a) acc[a] += wy * row[a];
   }
-  double sum[2] = {0.0, 0.0};
+  Real sum[2] = {0.0, 0.0};
   for (int a = 0; a < W; ++a) {
     sum[0] += l.wx[a] * acc[2 * a];
     sum[1] += l.wx[a] * acc[2 * a + 1];
@@ -101,11 +101,11 @@ void interpolate(const Located& l, const double* e, Index padded_x, double& out1
 }
 
 template <int W>
-void interpolate_all(const double* base, ParticleLayout layout, Index particles, double inverse_dx, double inverse_dy,
-                     int n_x, int n_y, Index padded_x, const double* e, double* out) {
+void interpolate_all(const Real* base, ParticleLayout layout, Index particles, Real inverse_dx, Real inverse_dy,
+                     int n_x, int n_y, Index padded_x, const Real* e, Real* out) {
   const Index ps = layout.particle_stride, cs = layout.component_stride;
   for (Index k = 0; k < particles; ++k) {
-    const double* p = base + k * ps;
+    const Real* p = base + k * ps;
     const Located l = locate<W>(p[0], p[cs], inverse_dx, inverse_dy, n_x, n_y, padded_x);
     interpolate<W>(l, e, padded_x, out[2 * k], out[2 * k + 1]);
   }
@@ -113,8 +113,8 @@ void interpolate_all(const double* base, ParticleLayout layout, Index particles,
 
 }  // namespace
 
-double Geometry::length_x() const { return two_pi / k_x; }
-double Geometry::length_y() const { return two_pi / k_y; }
+Real Geometry::length_x() const { return two_pi / k_x; }
+Real Geometry::length_y() const { return two_pi / k_y; }
 
 Field::Field(const Geometry& geometry, const Collective* collective)
     : g_(geometry),
@@ -138,14 +138,14 @@ Field::Field(const Geometry& geometry, const Collective* collective)
     const int jy = static_cast<int>(p / half_x), ix = static_cast<int>(p % half_x);
     k1_(p) = g_.k_x * ix;
     k2_(p) = g_.k_y * grid_.wave_number(0, jy);
-    const double k_squared = k1_(p) * k1_(p) + k2_(p) * k2_(p);
+    const Real k_squared = k1_(p) * k1_(p) + k2_(p) * k2_(p);
     inverse_k2_(p) = k_squared > 0.0 ? 1.0 / k_squared : 0.0;  // the mean: no field
   }
 }
 
 Field::~Field() = default;
 
-void Field::deposit(const double* base, ParticleLayout layout) {
+void Field::deposit(const Real* base, ParticleLayout layout) {
   padded_rho_.setZero();
   if (width_ == 2)
     deposit_all<2>(base, layout, g_.particles, g_.weight(), inverse_dx_, inverse_dy_, g_.n_x, g_.n_y, padded_x_,
@@ -155,11 +155,11 @@ void Field::deposit(const double* base, ParticleLayout layout) {
                    padded_rho_.data());
   // Fold the padding onto the periodic grid: padded (J, I) is node (J - offset, I - offset) mod n.
   auto values = transforms_->values();
-  double* rho = values.col(0).data();
+  Real* rho = values.col(0).data();
   values.col(0).setZero();
   for (Index J = 0; J < padded_y_; ++J) {
-    double* row = rho + ((J - offset_ + g_.n_y) % g_.n_y) * g_.n_x;
-    const double* from = padded_rho_.data() + J * padded_x_;
+    Real* row = rho + ((J - offset_ + g_.n_y) % g_.n_y) * g_.n_x;
+    const Real* from = padded_rho_.data() + J * padded_x_;
     for (Index I = 0; I < padded_x_; ++I) row[(I - offset_ + g_.n_x) % g_.n_x] += from[I];
   }
   if (collective_) collective_->sum(rho, static_cast<Index>(g_.n_x) * g_.n_y);  // the whole plasma's
@@ -167,14 +167,14 @@ void Field::deposit(const double* base, ParticleLayout layout) {
 
 void Field::poisson() {
   auto values = transforms_->values();
-  const double cell = g_.dx() * g_.dy();
+  const Real cell = g_.dx() * g_.dy();
   values.col(0) /= cell;
   charge_ = values.col(0).sum() * cell;
   values.col(0).array() -= charge_ / (g_.length_x() * g_.length_y());
   values.col(1).setZero();
   transforms_->forward();
   auto spectrum = transforms_->spectrum();
-  const double scale = 1.0 / static_cast<double>(grid_.points());  // the unnormalised pair's n_x n_y
+  const Real scale = 1.0 / static_cast<Real>(grid_.points());  // the unnormalised pair's n_x n_y
   for (Index p = 0; p < spectrum.rows(); ++p) {
     const Complex rho_hat = spectrum(p, 0) * (scale * inverse_k2_(p));
     spectrum(p, 0) = Complex(0.0, -k1_(p)) * rho_hat;
@@ -187,8 +187,8 @@ void Field::poisson() {
 void Field::pad_field() {
   if (padded_current_) return;
   auto values = transforms_->values();
-  const double* e1 = values.col(0).data();
-  const double* e2 = values.col(1).data();
+  const Real* e1 = values.col(0).data();
+  const Real* e2 = values.col(1).data();
   for (Index J = 0; J < padded_y_; ++J) {
     const Index row = ((J - offset_ + g_.n_y) % g_.n_y) * g_.n_x;
     for (Index I = 0; I < padded_x_; ++I) {
@@ -200,7 +200,7 @@ void Field::pad_field() {
   padded_current_ = true;
 }
 
-void Field::solve(const double* base, ParticleLayout layout) {
+void Field::solve(const Real* base, ParticleLayout layout) {
   // Split over processes, the last solve is reused only where every process's positions are
   // its own last ones: all of them then skip the density's reduction together.
   const bool same = same_positions(base, layout);
@@ -217,7 +217,7 @@ void Field::solve(const double* base, ParticleLayout layout) {
   e_at_solved_ = false;
 }
 
-bool Field::same_positions(const double* base, ParticleLayout layout) const {
+bool Field::same_positions(const Real* base, ParticleLayout layout) const {
   if (!solved_) return false;
   const Index ps = layout.particle_stride, cs = layout.component_stride;
   for (Index k = 0; k < g_.particles; ++k)
@@ -225,7 +225,7 @@ bool Field::same_positions(const double* base, ParticleLayout layout) const {
   return true;
 }
 
-const double* Field::interpolate(const double* base, ParticleLayout layout) {
+const Real* Field::interpolate(const Real* base, ParticleLayout layout) {
   pad_field();
   e_at_.resize(2 * g_.particles);
   if (width_ == 2)
@@ -238,7 +238,7 @@ const double* Field::interpolate(const double* base, ParticleLayout layout) {
   return e_at_.data();
 }
 
-const double* Field::at_particles(const double* base, ParticleLayout layout) {
+const Real* Field::at_particles(const Real* base, ParticleLayout layout) {
   solve(base, layout);
   if (!e_at_solved_) {
     interpolate(base, layout);
@@ -247,7 +247,7 @@ const double* Field::at_particles(const double* base, ParticleLayout layout) {
   return e_at_.data();
 }
 
-double Field::field_energy() const {
+Real Field::field_energy() const {
   auto values = transforms_->values();
   return 0.5 * values.squaredNorm() * g_.dx() * g_.dy();
 }

@@ -19,18 +19,18 @@ enum class Shape { cic, m6 };
 /// The box, its grid and the particles' common weight.
 struct Geometry {
   int n_x = 16, n_y = 16;
-  double k_x = 0.5, k_y = 1.0;
+  Real k_x = 0.5, k_y = 1.0;
   Shape shape = Shape::m6;
   Index particles = 1;       ///< the particles this process holds
   Index all_particles = 0;   ///< the plasma's, when split over processes (0: the same)
 
-  double length_x() const;
-  double length_y() const;
-  double dx() const { return length_x() / n_x; }
-  double dy() const { return length_y() / n_y; }
+  Real length_x() const;
+  Real length_y() const;
+  Real dx() const { return length_x() / n_x; }
+  Real dy() const { return length_y() / n_y; }
   /// |box| / N: the particles carry the box's unit mean density between them.
-  double weight() const {
-    return length_x() * length_y() / static_cast<double>(all_particles > 0 ? all_particles : particles);
+  Real weight() const {
+    return length_x() * length_y() / static_cast<Real>(all_particles > 0 ? all_particles : particles);
   }
 };
 
@@ -58,28 +58,28 @@ class Field {
   /// rho deposited from the positions of the N particles at `base` (layout), then E; nothing
   /// to do for the positions of the last solve (the columns of the constant grid order-2 data
   /// evaluate, or W, Q and W_E of one state, share one solve).
-  void solve(const double* base, ParticleLayout layout);
+  void solve(const Real* base, ParticleLayout layout);
   /// E at each of the N particles at `base`: (E1, E2) of particle k at 2k, 2k + 1, from the
   /// field of these same positions (computed once for the positions of the last solve).
-  const double* at_particles(const double* base, ParticleLayout layout);
+  const Real* at_particles(const Real* base, ParticleLayout layout);
   /// E of the last solve at each of the N particles at `base` (as at_particles' values).
-  const double* interpolate(const double* base, ParticleLayout layout);
+  const Real* interpolate(const Real* base, ParticleLayout layout);
   /// (1/2) int |E|^2 over the box (the grid's rectangle rule) of the last solve.
-  double field_energy() const;
+  Real field_energy() const;
   /// int rho over the box before the mean was taken off (N w = |box| when nothing is lost).
-  double charge() const { return charge_; }
+  Real charge() const { return charge_; }
 
  private:
-  void deposit(const double* base, ParticleLayout layout);
+  void deposit(const Real* base, ParticleLayout layout);
   void poisson();
   void pad_field();
-  bool same_positions(const double* base, ParticleLayout layout) const;
+  bool same_positions(const Real* base, ParticleLayout layout) const;
 
   Geometry g_;
   const Collective* collective_;
   int width_, offset_;          // stencil nodes first - offset .. first - offset + width - 1
   Index padded_x_, padded_y_;   // n + width - 1
-  double inverse_dx_, inverse_dy_;
+  Real inverse_dx_, inverse_dy_;
   SpectralGrid grid_;  // (n_y, n_x) in C order: x the last direction, halved by the real transforms
   std::unique_ptr<RealGridTransforms> transforms_;  // 2 columns: rho, then E1 and E2
   RealVector padded_rho_;  // padded_y x padded_x, x fastest
@@ -90,7 +90,7 @@ class Field {
   bool solved_ = false;
   RealVector e_at_;           // E at the particles of the last interpolation
   bool e_at_solved_ = false;  // ... and those are the positions of the last solve
-  double charge_ = 0.0;
+  Real charge_ = 0.0;
 };
 
 }  // namespace tsi::pic

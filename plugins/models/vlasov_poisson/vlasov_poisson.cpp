@@ -21,6 +21,7 @@
 
 namespace {
 
+using tsi::Real;
 using tsi::Index;
 using tsi::MatrixRef;
 using tsi::Vector;
@@ -37,12 +38,12 @@ constexpr ParticleLayout real_layout{4, 1};
 // f_tau at one phase (cos, sin) for the particles of one column, given E at them:
 // (R(tau) y, R(-tau) E) per particle (E is computed before, so out may be the column itself).
 template <class Write>
-void filtered_column(const double* e, Index particles, const double* u, ParticleLayout layout, double c, double s,
+void filtered_column(const Real* e, Index particles, const Real* u, ParticleLayout layout, Real c, Real s,
                      Write&& write) {
   const Index ps = layout.particle_stride, cs = layout.component_stride;
   for (Index k = 0; k < particles; ++k) {
-    const double* p = u + k * ps;
-    const double y1 = p[2 * cs], y2 = p[3 * cs], e1 = e[2 * k], e2 = e[2 * k + 1];
+    const Real* p = u + k * ps;
+    const Real y1 = p[2 * cs], y2 = p[3 * cs], e1 = e[2 * k], e2 = e[2 * k + 1];
     write(k, 0, c * y1 + s * y2);
     write(k, 1, -s * y1 + c * y2);
     write(k, 2, c * e1 - s * e2);
@@ -58,7 +59,7 @@ enum class TauField { per_tau, diagonal };
 
 class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, public tsi::PhysicalVariables {
  public:
-  VlasovPoisson2d(double eps, Geometry geometry, TauField tau_field, tsi::RealVector particles,
+  VlasovPoisson2d(Real eps, Geometry geometry, TauField tau_field, tsi::RealVector particles,
                   const tsi::Collective* collective)
       : Model(eps), g_(geometry), tau_field_(tau_field), u0_(std::move(particles)), collective_(collective) {}
 
@@ -70,9 +71,9 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
 
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
     for (Index j = 0; j < u.cols(); ++j) {
-      const double c = std::cos(taus(j)), s = std::sin(taus(j));
+      const Real c = std::cos(taus(j)), s = std::sin(taus(j));
       for (Index k = 0; k < g_.particles; ++k) {
-        const double v1 = u(4 * k + 2, j).real(), v2 = u(4 * k + 3, j).real();
+        const Real v1 = u(4 * k + 2, j).real(), v2 = u(4 * k + 3, j).real();
         u(4 * k + 2, j) = c * v1 + s * v2;
         u(4 * k + 3, j) = -s * v1 + c * v2;
       }
@@ -84,9 +85,9 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
     Field& field = shared_field();
     // f = f_0 = (v, E(x)): the filtered column at tau = 0, where R(0) = I.
     for (Index j = 0; j < u.cols(); ++j) {
-      const double* column = reinterpret_cast<const double*>(u.col(j).data());
+      const Real* column = reinterpret_cast<const Real*>(u.col(j).data());
       filtered_column(field.at_particles(column, complex_layout), g_.particles, column, complex_layout, 1.0, 0.0,
-                      [&](Index k, int c, double value) { out(4 * k + c, j) = value; });
+                      [&](Index k, int c, Real value) { out(4 * k + c, j) = value; });
     }
   }
 
@@ -108,18 +109,18 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
         : g_(g), tau_field_(tau_field), field_(g, collective), cos_(taus.array().cos()), sin_(taus.array().sin()) {}
     void evaluate(MatrixRef u, MatrixRef out) override {
       for (Index j = 0; j < u.cols(); ++j) {
-        const double* column = reinterpret_cast<const double*>(u.col(j).data());
+        const Real* column = reinterpret_cast<const Real*>(u.col(j).data());
         filtered_column(e_at(column, complex_layout), g_.particles, column, complex_layout, cos_(j), sin_(j),
-                        [&](Index k, int c, double value) { out(4 * k + c, j) = value; });
+                        [&](Index k, int c, Real value) { out(4 * k + c, j) = value; });
       }
     }
     bool evaluates_real() const override { return true; }
     bool in_place() const override { return true; }  // E is computed from every position first
     void evaluate_real(tsi::RealMatrixRef u, tsi::RealMatrixRef out) override {
       for (Index j = 0; j < u.cols(); ++j) {
-        double* o = out.col(j).data();
+        Real* o = out.col(j).data();
         filtered_column(e_at(u.col(j).data(), real_layout), g_.particles, u.col(j).data(), real_layout, cos_(j),
-                        sin_(j), [o](Index k, int c, double value) { o[4 * k + c] = value; });
+                        sin_(j), [o](Index k, int c, Real value) { o[4 * k + c] = value; });
       }
     }
     bool needs_diagonal() const override { return tau_field_ == TauField::diagonal; }
@@ -130,11 +131,11 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
 
    private:
     // E at the particles of one column: from their own field, or from the diagonal's.
-    const double* e_at(const double* column, ParticleLayout layout) {
+    const Real* e_at(const Real* column, ParticleLayout layout) {
       if (tau_field_ == TauField::per_tau) return field_.at_particles(column, layout);
       if (!diagonal_) throw tsi::Error("vlasov-poisson-2d: the diagonal field was evaluated without the diagonal");
       if (!diagonal_solved_) {
-        field_.solve(reinterpret_cast<const double*>(diagonal_->data()), complex_layout);
+        field_.solve(reinterpret_cast<const Real*>(diagonal_->data()), complex_layout);
         diagonal_solved_ = true;
       }
       return field_.interpolate(column, layout);
@@ -158,9 +159,9 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
     const std::lock_guard<std::mutex> lock(mutex_);
     Field& field = shared_field();
     for (Index j = 0; j < u.cols(); ++j) {
-      const double* column = reinterpret_cast<const double*>(u.col(j).data());
+      const Real* column = reinterpret_cast<const Real*>(u.col(j).data());
       filtered_column(field.at_particles(column, complex_layout), g_.particles, column, complex_layout,
-                      std::cos(taus(j)), std::sin(taus(j)), [&](Index k, int c, double value) { out(4 * k + c, j) = value; });
+                      std::cos(taus(j)), std::sin(taus(j)), [&](Index k, int c, Real value) { out(4 * k + c, j) = value; });
     }
   }
 
@@ -171,8 +172,8 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   std::vector<Index> physical_shape() const override {
     return {g_.all_particles > 0 ? g_.all_particles : g_.particles, 4};  // the whole plasma's
   }
-  double error_norm(const Vector& x) const override {
-    double squares = x.squaredNorm();
+  Real error_norm(const Vector& x) const override {
+    Real squares = x.squaredNorm();
     if (collective_) collective_->sum(&squares, 1);
     return std::sqrt(squares);
   }
@@ -180,10 +181,10 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   // The state files keep positions in the box (a run carries them out unwrapped, and a file
   // farther out than a box length would be refused by check_positions).
   void canonicalize_physical(Vector& x) const override {
-    const double lengths[2] = {g_.length_x(), g_.length_y()};
+    const Real lengths[2] = {g_.length_x(), g_.length_y()};
     for (Index k = 0; k < x.size() / 4; ++k)
       for (int c = 0; c < 2; ++c) {
-        double p = x(4 * k + c).real();
+        Real p = x(4 * k + c).real();
         if (p >= 0.0 && p < lengths[c]) continue;
         p -= lengths[c] * std::floor(p / lengths[c]);
         x(4 * k + c) = p < lengths[c] ? p : 0.0;  // a rounding up to L is the box's 0
@@ -194,7 +195,7 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
     const Geometry g = g_;
     const tsi::Collective* collective = collective_;  // sums over the processes of a split run
     const auto kinetic = [g, collective](const Vector& u) {
-      double sum = 0.0;
+      Real sum = 0.0;
       for (Index k = 0; k < g.particles; ++k) sum += std::norm(u(4 * k + 2)) + std::norm(u(4 * k + 3));
       if (collective) collective->sum(&sum, 1);
       return 0.5 * g.weight() * sum;
@@ -207,7 +208,7 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
          }},
         {"P", "|total momentum| |sum w v| (P turns with the field: R(t/eps) P(0))",
          [g, collective](const Vector& u) {
-           double p[2] = {0.0, 0.0};
+           Real p[2] = {0.0, 0.0};
            for (Index k = 0; k < g.particles; ++k) {
              p[0] += u(4 * k + 2).real();
              p[1] += u(4 * k + 3).real();
@@ -238,7 +239,7 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   // The shared field solved for the positions of a model state (callers hold mutex_).
   Field& field_of(const Vector& u) const {
     Field& field = shared_field();
-    field.solve(reinterpret_cast<const double*>(u.data()), complex_layout);
+    field.solve(reinterpret_cast<const Real*>(u.data()), complex_layout);
     return field;
   }
 
@@ -266,7 +267,7 @@ void register_vlasov_poisson(tsi::Registry& registry) {
           .check(
               [](const tsi::Json& v) {
                 if (v.is_string()) return !v.get<std::string>().empty();
-                return v.get<double>() >= 1 && v.get<double>() <= double(1L << 28);
+                return v.get<Real>() >= 1 && v.get<Real>() <= Real(1L << 28);
               },
               "a number of particles from 1 to 2^28, or a file name"),
       tsi::integer_param("n_x", 16, "grid points along x1 (even)")
@@ -311,7 +312,7 @@ void register_vlasov_poisson(tsi::Registry& registry) {
       g.particles = particles.size() / 4;
       tsi::pic::check_positions(particles, g, given.get<std::string>());
     } else {
-      g.particles = static_cast<Index>(given.get<double>());
+      g.particles = static_cast<Index>(given.get<Real>());
       const auto distribution =
           p.string("distribution") == "peer" ? tsi::pic::Distribution::peer : tsi::pic::Distribution::landau;
       particles = tsi::pic::sample_particles(g, distribution, p.number("alpha"), static_cast<std::uint64_t>(p.integer("seed")));

@@ -22,6 +22,7 @@
 namespace {
 
 using tsi::Complex;
+using tsi::Real;
 using tsi::Vector;
 
 class Collocation final : public tsi::Stepper {
@@ -31,7 +32,7 @@ class Collocation final : public tsi::Stepper {
     tsi::FixedPointOptions options;
   };
 
-  Collocation(tsi::Problem& problem, double h, const Settings& settings)
+  Collocation(tsi::Problem& problem, Real h, const Settings& settings)
       : Stepper(problem, h),
         s_(settings.stages),
         nodes_(tsi::gauss_legendre(settings.stages).nodes),
@@ -43,7 +44,7 @@ class Collocation final : public tsi::Stepper {
     // mode on the two-scale problem without a remainder: tsi::Diagonal).
     const tsi::InterpolatoryWeights weights_of(nodes_);
     const tsi::Diagonal& lambda = problem.linear_multipliers();
-    const auto scaled = [&](double kappa) {
+    const auto scaled = [&](Real kappa) {
       return [&, kappa](Complex z) {
         std::vector<Complex> w = weights_of(kappa, z);
         for (Complex& x : w) x *= h;
@@ -57,7 +58,7 @@ class Collocation final : public tsi::Stepper {
     tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_full_);
     tsi::diagonal_functions(lambda, h, scaled(1.0), pointers(b_));
     for (int i = 0; i < s_; ++i) {
-      const double c = nodes_[i];
+      const Real c = nodes_[i];
       tsi::diagonal_function(lambda, h, [c](Complex z) { return std::exp(c * z); }, e_stage_[i]);
       tsi::diagonal_functions(lambda, h, scaled(c), pointers(a_[i]));
     }
@@ -70,7 +71,7 @@ class Collocation final : public tsi::Stepper {
 
   // The stages' bases e^{c_i z} y_n are not stored: every sweep forms them again in the pass
   // that adds the a_ij N_j (the same products in the same order), s vectors less.
-  void step(double t, Vector& y) override {
+  void step(Real t, Vector& y) override {
     const tsi::Index n = y.size();
     // Starting guess: the stages with the previous step's N, else the linear flow alone.
     if (guess_.from_previous())
@@ -125,7 +126,7 @@ class Collocation final : public tsi::Stepper {
   }
 
   int s_;
-  std::vector<double> nodes_;
+  std::vector<Real> nodes_;
   std::unique_ptr<tsi::FixedPointSolver> solver_;
   tsi::StageGuess guess_;
   tsi::FixedPointOptions options_;

@@ -17,21 +17,22 @@
 
 namespace {
 
+using tsi::Real;
 using tsi::Json;
 using tsi::Vector;
 
 struct Method {
   const char* name;
   int order;
-  std::vector<double> weights;  // substep lengths as fractions of h, palindromic, summing to 1
+  std::vector<Real> weights;  // substep lengths as fractions of h, palindromic, summing to 1
 };
 
 std::vector<Method> methods() {
-  const double g1 = 1.0 / (2.0 - std::cbrt(2.0));
-  const double g = 1.0 / (4.0 - std::cbrt(4.0));
+  const Real g1 = 1 / (2 - std::cbrt(Real(2)));
+  const Real g = 1 / (4 - std::cbrt(Real(4)));
   // Yoshida (1990), Phys. Lett. A 150, 262, table 1, solution A.
-  const double w1 = -1.17767998417887, w2 = 0.235573213359357, w3 = 0.784513610477560;
-  const double w0 = 1.0 - 2.0 * (w1 + w2 + w3);
+  const Real w1 = -1.17767998417887, w2 = 0.235573213359357, w3 = 0.784513610477560;
+  const Real w0 = 1.0 - 2.0 * (w1 + w2 + w3);
   return {{"triple-jump", 4, {g1, 1.0 - 2.0 * g1, g1}},
           {"suzuki5", 4, {g, g, 1.0 - 4.0 * g, g, g}},
           {"yoshida6", 6, {w3, w2, w1, w0, w1, w2, w3}}};
@@ -66,9 +67,9 @@ const tsi::SchemeEntry& base_entry(const tsi::Registry& registry, const Json& pa
 
 class Composition final : public tsi::Stepper {
  public:
-  Composition(tsi::Problem& problem, double h, const tsi::Scheme& base, const Method& method)
+  Composition(tsi::Problem& problem, Real h, const tsi::Scheme& base, const Method& method)
       : Stepper(problem, h) {
-    for (double w : method.weights) {
+    for (Real w : method.weights) {
       const auto k = static_cast<size_t>(std::find(weights_.begin(), weights_.end(), w) - weights_.begin());
       if (k == weights_.size()) {  // a new substep length
         weights_.push_back(w);
@@ -82,7 +83,7 @@ class Composition final : public tsi::Stepper {
     for (auto& b : bound_) b->reset();
   }
 
-  void step(double t, Vector& y) override {
+  void step(Real t, Vector& y) override {
     for (size_t k : substeps_) {
       bound_[k]->step(t, y);
       t += weights_[k] * h_;
@@ -102,7 +103,7 @@ class Composition final : public tsi::Stepper {
   }
 
  private:
-  std::vector<double> weights_;                      // the distinct substep fractions
+  std::vector<Real> weights_;                      // the distinct substep fractions
   std::vector<std::unique_ptr<tsi::Stepper>> bound_;  // the base bound to each
   std::vector<size_t> substeps_;                     // the method's substeps, as indices
 };
@@ -111,13 +112,13 @@ class Composition final : public tsi::Stepper {
 class CompositionScheme final : public tsi::Scheme {
  public:
   CompositionScheme(std::unique_ptr<tsi::Scheme> base, const Method& method) : base_(std::move(base)), method_(method) {}
-  std::unique_ptr<tsi::Stepper> bind(tsi::Problem& problem, double h) const override {
+  std::unique_ptr<tsi::Stepper> bind(tsi::Problem& problem, Real h) const override {
     return std::make_unique<Composition>(problem, h, *base_, method_);
   }
   // The base bound once per distinct substep length.
   double state_vectors(const tsi::ProblemLayout& layout) const override {
-    std::vector<double> lengths;
-    for (double w : method_.weights)
+    std::vector<Real> lengths;
+    for (Real w : method_.weights)
       if (std::find(lengths.begin(), lengths.end(), w) == lengths.end()) lengths.push_back(w);
     return static_cast<double>(lengths.size()) * base_->state_vectors(layout);
   }

@@ -27,6 +27,7 @@
 namespace {
 
 using tsi::Complex;
+using tsi::Real;
 using tsi::Vector;
 
 constexpr int max_order = 6;
@@ -40,7 +41,7 @@ struct Settings {
 
 class Eab final : public tsi::Stepper {
  public:
-  Eab(tsi::Problem& problem, double h, const Settings& settings)
+  Eab(tsi::Problem& problem, Real h, const Settings& settings)
       : Stepper(problem, h), r_(settings.order), startup_(settings.startup) {
     // The weights of N_{-j} for the value at kappa h: kappa = 1 the step, -k the start-up,
     // with the factor h folded in (one value per tau mode on the two-scale problem without a
@@ -50,7 +51,7 @@ class Eab final : public tsi::Stepper {
     weights_.assign(r_, {});
     exponentials_.assign(r_, tsi::Diagonal());
     for (int k = 0; k < r_; ++k) {
-      const double kappa = k == 0 ? 1.0 : -static_cast<double>(k);
+      const Real kappa = k == 0 ? 1.0 : -static_cast<Real>(k);
       tsi::diagonal_function(lambda, h, [kappa](Complex z) { return std::exp(kappa * z); }, exponentials_[k]);
       scaled_weights(lambda, h, weights_of, kappa, weights_[k]);
     }
@@ -66,7 +67,7 @@ class Eab final : public tsi::Stepper {
     next_level_ = 0;
   }
 
-  void step(double t, Vector& y) override {
+  void step(Real t, Vector& y) override {
     if (startup_ == Startup::hoodesolver && r_ > 1) {
       // The start-up's forward values are the first steps.
       if (!started_) {
@@ -112,7 +113,7 @@ class Eab final : public tsi::Stepper {
   }
 
   // N at t, t - h, ..., t - (r-1) h, the past values from r passes of the interpolatory formula.
-  void start(double t, const Vector& y) {
+  void start(Real t, const Vector& y) {
     problem_.nonlinear(t, y, history_[0]);
     for (int j = 1; j < r_; ++j) tsi::algebra::copy(history_[0], history_[j]);
     for (int pass = 0; pass < r_; ++pass) {
@@ -122,14 +123,14 @@ class Eab final : public tsi::Stepper {
     started_ = true;
   }
 
-  static std::vector<double> past_nodes(int r) {
-    std::vector<double> nodes(r);
+  static std::vector<Real> past_nodes(int r) {
+    std::vector<Real> nodes(r);
     for (int j = 0; j < r; ++j) nodes[j] = -j;
     return nodes;
   }
   // h w_j(kappa, hL) for every node of weights_of, one Diagonal each (the factor h folded in).
-  static void scaled_weights(const tsi::Diagonal& lambda, double h, const tsi::InterpolatoryWeights& weights_of,
-                             double kappa, std::vector<tsi::Diagonal>& out) {
+  static void scaled_weights(const tsi::Diagonal& lambda, Real h, const tsi::InterpolatoryWeights& weights_of,
+                             Real kappa, std::vector<tsi::Diagonal>& out) {
     const int m = static_cast<int>(weights_of.nodes().size());
     out.assign(m, tsi::Diagonal());
     std::array<tsi::Diagonal*, max_order> outs{};
@@ -143,15 +144,15 @@ class Eab final : public tsi::Stepper {
         },
         std::span<tsi::Diagonal* const>(outs.data(), m));
   }
-  static std::vector<double> future_nodes(int r) {
-    std::vector<double> nodes(r);
+  static std::vector<Real> future_nodes(int r) {
+    std::vector<Real> nodes(r);
     for (int j = 0; j < r; ++j) nodes[j] = j;
     return nodes;
   }
 
   // HOODESolver's stages: for q = 2 .. r, the backward formula of order q - 1 (nodes 0 .. q - 2
   // after the base, kappa = -1) and the forward one of order q (nodes 0 .. -(q - 1), kappa = 1).
-  void prepare_stages(const tsi::Diagonal& lambda, double h) {
+  void prepare_stages(const tsi::Diagonal& lambda, Real h) {
     tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(-z); }, backward_exponential_);
     backward_.assign(r_ + 1, {});
     forward_.assign(r_ + 1, {});
@@ -174,7 +175,7 @@ class Eab final : public tsi::Stepper {
     return m < 0 ? backward_n_[static_cast<size_t>(-m - 1)] : history_[static_cast<size_t>(r_ - 1 - m)];
   }
 
-  void start_by_stages(double t, Vector& y) {
+  void start_by_stages(Real t, Vector& y) {
     problem_.nonlinear(t, y, level_n(0));
     std::array<const tsi::Diagonal*, max_order + 1> d{};
     std::array<const Vector*, max_order + 1> x{};

@@ -19,12 +19,13 @@
 namespace {
 
 namespace algebra = tsi::algebra;
+using tsi::Real;
 using tsi::Complex;
 using tsi::Vector;
 
 class Etd2rk final : public tsi::Stepper {
  public:
-  Etd2rk(tsi::Problem& problem, double h, std::monostate)
+  Etd2rk(tsi::Problem& problem, Real h, std::monostate)
       : Stepper(problem, h), n0_(problem.new_state()), star_(problem.new_state()), n1_(problem.new_state()) {
     const tsi::Diagonal& lambda = problem.linear_multipliers();
     tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_);
@@ -33,7 +34,7 @@ class Etd2rk final : public tsi::Stepper {
     p1_minus_p2_ = tsi::Diagonal(p1_.values() - p2_.values(), lambda.run());
   }
 
-  void step(double t, Vector& y) override {
+  void step(Real t, Vector& y) override {
     problem_.nonlinear(t, y, n0_);
     algebra::diagonal_combination(e_, y, p1_, n0_, star_);
     problem_.nonlinear(t + h_, star_, n1_);

@@ -22,12 +22,13 @@
 namespace {
 
 namespace algebra = tsi::algebra;
+using tsi::Real;
 using tsi::Complex;
 using tsi::Vector;
 
 class Fd final : public tsi::Stepper {
  public:
-  Fd(tsi::Problem& problem, double h, std::monostate)
+  Fd(tsi::Problem& problem, Real h, std::monostate)
       : Stepper(problem, h), half_(problem.new_state()), n_(problem.new_state()) {
     const tsi::Diagonal& lambda = problem.linear_multipliers();
     const Vector& remainder = problem.remainder_multipliers();
@@ -38,12 +39,12 @@ class Fd final : public tsi::Stepper {
     const tsi::Index n = values.size();
     Vector inverse(n), half_inverse(n), cayley(n), full_inverse(n);
     for (tsi::Index i = 0; i < n; ++i) {
-      const Complex r = remainder.size() ? remainder(i) : Complex(0.0);
-      const Complex z = 0.5 * h * (values(i) - r);  // h L_tau / 2
-      const Complex half_turn = std::exp(0.5 * h * r), inv = 1.0 / (1.0 - z);
+      const Complex r = remainder.size() ? remainder(i) : Complex(0);
+      const Complex z = Real(0.5) * h * (values(i) - r);  // h L_tau / 2
+      const Complex half_turn = std::exp(Real(0.5) * h * r), inv = Real(1) / (Real(1) - z);
       inverse(i) = half_turn * inv;
-      half_inverse(i) = 0.5 * h * half_turn * inv;
-      cayley(i) = half_turn * half_turn * (1.0 + z) * inv;
+      half_inverse(i) = Real(0.5) * h * half_turn * inv;
+      cayley(i) = half_turn * half_turn * (Real(1) + z) * inv;
       full_inverse(i) = h * half_turn * inv;
     }
     inverse_ = tsi::Diagonal(std::move(inverse), run);
@@ -52,7 +53,7 @@ class Fd final : public tsi::Stepper {
     full_inverse_ = tsi::Diagonal(std::move(full_inverse), run);
   }
 
-  void step(double t, Vector& y) override {
+  void step(Real t, Vector& y) override {
     problem_.nonlinear(t, y, n_);
     algebra::diagonal_combination(inverse_, y, half_inverse_, n_, half_);
     problem_.nonlinear(t + 0.5 * h_, half_, n_);

@@ -13,12 +13,13 @@
 namespace {
 
 namespace algebra = tsi::algebra;
+using tsi::Real;
 using tsi::Complex;
 using tsi::Vector;
 
 class Me final : public tsi::Stepper {
  public:
-  Me(tsi::Problem& problem, double h, std::monostate)
+  Me(tsi::Problem& problem, Real h, std::monostate)
       : Stepper(problem, h), n_(problem.new_state()), previous_(problem.new_state()) {
     const tsi::Diagonal& lambda = problem.linear_multipliers();
     tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_);
@@ -30,7 +31,7 @@ class Me final : public tsi::Stepper {
 
   void reset() override { has_previous_ = false; }
 
-  void step(double t, Vector& y) override {
+  void step(Real t, Vector& y) override {
     problem_.nonlinear(t, y, n_);
     if (has_previous_) {
       algebra::diagonal_combination(e_, y, p12_, n_, minus_p2_, previous_, y);

@@ -14,42 +14,43 @@
 namespace {
 
 namespace odeint = boost::numeric::odeint;
+using tsi::Real;
 using tsi::Complex;
 using tsi::Vector;
-using State = std::vector<double>;  // (re, im) pairs of the complex state
+using State = std::vector<Real>;  // (re, im) pairs of the complex state
 
 // Odeint's error test with the tolerance relative to the full state anchor + z, while the
 // stepper itself sees only the deviation z (see Rk78::step).
 struct AnchoredErrorChecker {
-  using value_type = double;
+  using value_type = Real;
   using algebra_type = odeint::range_algebra;
   using operations_type = odeint::default_operations;
 
-  double tol = 1e-10;
+  Real tol = 1e-10;
   const State* anchor = nullptr;
 
   template <class S, class D, class E, class T>
-  double error(algebra_type& /*algebra*/, const S& z, const D& dzdt, E& err, T dt) const {
-    double worst = 0.0;
+  Real error(algebra_type& /*algebra*/, const S& z, const D& dzdt, E& err, T dt) const {
+    Real worst = 0.0;
     for (size_t i = 0; i < z.size(); ++i) {
-      const double scale = tol + tol * (std::abs((*anchor)[i] + z[i]) + std::abs(dt) * std::abs(dzdt[i]));
+      const Real scale = tol + tol * (std::abs((*anchor)[i] + z[i]) + std::abs(dt) * std::abs(dzdt[i]));
       worst = std::max(worst, std::abs(err[i]) / scale);
     }
     return worst;
   }
 };
 
-using Controlled = odeint::controlled_runge_kutta<odeint::runge_kutta_fehlberg78<State>, AnchoredErrorChecker,
-                                                  odeint::default_step_adjuster<double, double>,
+using Controlled = odeint::controlled_runge_kutta<odeint::runge_kutta_fehlberg78<State, Real, State, Real>, AnchoredErrorChecker,
+                                                  odeint::default_step_adjuster<Real, Real>,
                                                   odeint::initially_resizer, odeint::explicit_error_stepper_tag>;
 
 class Rk78 final : public tsi::Stepper {
  public:
   struct Settings {
-    double tol, substeps_per_period;
+    Real tol, substeps_per_period;
   };
 
-  Rk78(tsi::Problem& problem, double h, const Settings& settings)
+  Rk78(tsi::Problem& problem, Real h, const Settings& settings)
       : Stepper(problem, h),
         tol_(settings.tol),
         substeps_per_period_(settings.substeps_per_period),
@@ -67,14 +68,14 @@ class Rk78 final : public tsi::Stepper {
   // rounds at ulp(y) per substep; over the 10^6 .. 10^8 substeps of a small-eps run that
   // accumulates (charged particle, eps = 1e-6: 4e-13 in p = 2 eps v - B x, 2e-7 in v, and
   // systematic when the substeps divide the fast period), while z rounds at ulp(z).
-  void step(double t, Vector& y) override {
-    const double h = h_;
+  void step(Real t, Vector& y) override {
+    const Real h = h_;
     const auto n = y.size();
     const size_t m = 2 * static_cast<size_t>(n);
     std::fill(lo_.begin(), lo_.end(), 0.0);
     Eigen::Map<Vector>(reinterpret_cast<Complex*>(hi_.data()), n) = y;
-    auto system = [&](const State& z, State& dzdt, double time) {
-      double* in = reinterpret_cast<double*>(in_.data());
+    auto system = [&](const State& z, State& dzdt, Real time) {
+      Real* in = reinterpret_cast<Real*>(in_.data());
       for (size_t i = 0; i < m; ++i) in[i] = hi_[i] + (lo_[i] + z[i]);
       problem_.rhs(time, in_, out_);
       dzdt.resize(m);
@@ -84,17 +85,17 @@ class Rk78 final : public tsi::Stepper {
 
     // Elapsed time as an unevaluated sum too: odeint's own t += dt would add a rounding per
     // substep, a phase error of steps * ulp / eps in the fast variable.
-    const double t_end = t + h;
-    const double max_dt = problem_.fast_period() / substeps_per_period_;
-    double t_hi = t, t_lo = 0.0;
+    const Real t_end = t + h;
+    const Real max_dt = problem_.fast_period() / substeps_per_period_;
+    Real t_hi = t, t_lo = 0.0;
     for (;;) {
-      const double remaining = (t_end - t_hi) - t_lo;
+      const Real remaining = (t_end - t_hi) - t_lo;
       if (remaining == 0.0 || remaining * h < 0.0) break;
       if (max_dt > 0.0 && std::abs(dt_) > max_dt) dt_ = std::copysign(max_dt, h);
       const bool last = std::abs(dt_) >= std::abs(remaining);
-      double dt = last ? remaining : dt_;
-      double t_try = t_hi + t_lo;
-      const double dt_taken = dt;
+      Real dt = last ? remaining : dt_;
+      Real t_try = t_hi + t_lo;
+      const Real dt_taken = dt;
       std::fill(z_.begin(), z_.end(), 0.0);
       bool accepted = controlled_.try_step(system, z_, t_try, dt) == odeint::success;
       if (accepted && !all_finite(z_)) {
@@ -124,38 +125,38 @@ class Rk78 final : public tsi::Stepper {
 
  private:
   // hi + lo += x, with the rounding of hi + x carried in lo (Knuth's two-sum).
-  static void two_sum(double& hi, double& lo, double x) {
-    const double sum = hi + x, b = sum - hi;
+  static void two_sum(Real& hi, Real& lo, Real x) {
+    const Real sum = hi + x, b = sum - hi;
     lo += (hi - (sum - b)) + (x - b);
     hi = sum;
   }
 
   static bool all_finite(const State& x) {
-    for (double v : x)
+    for (Real v : x)
       if (!std::isfinite(v)) return false;
     return true;
   }
 
   // The largest of the doubles of x, as the error test measures them (a real state held two
   // values to an entry gets the same substeps as held one to an entry).
-  static double max_double(const Vector& x) {
-    return Eigen::Map<const tsi::RealVector>(reinterpret_cast<const double*>(x.data()), 2 * x.size())
+  static Real max_double(const Vector& x) {
+    return Eigen::Map<const tsi::RealVector>(reinterpret_cast<const Real*>(x.data()), 2 * x.size())
         .cwiseAbs()
         .maxCoeff();
   }
 
   // Hairer-Norsett-Wanner's first guess: a step over which y changes by a small fraction.
-  double initial_substep(tsi::Problem& problem, double t, double h, const Vector& y) {
+  Real initial_substep(tsi::Problem& problem, Real t, Real h, const Vector& y) {
     problem.rhs(t, y, out_);
-    const double size = max_double(y), scale = tol_ + tol_ * size, rate = max_double(out_);
-    double dt = rate > 0.0 ? 0.01 * std::max(scale, size) / rate : std::abs(h);
+    const Real size = max_double(y), scale = tol_ + tol_ * size, rate = max_double(out_);
+    Real dt = rate > 0.0 ? 0.01 * std::max(scale, size) / rate : std::abs(h);
     dt = std::min(dt, std::abs(h));
     return h < 0.0 ? -dt : dt;
   }
 
-  double tol_;
-  double substeps_per_period_;
-  double dt_ = 0.0;  // the controller's last substep, carried across calls
+  Real tol_;
+  Real substeps_per_period_;
+  Real dt_ = 0.0;  // the controller's last substep, carried across calls
   State hi_, lo_, z_;
   Vector in_, out_;
   Controlled controlled_;  // after hi_: its error checker points at it
@@ -167,7 +168,7 @@ void register_rk78(tsi::Registry& registry) {
   entry.info.aliases = {"rkf78"};
   entry.info.summary = "classical adaptive Runge-Kutta-Fehlberg 7(8) (Boost.Odeint)";
   entry.info.params = {tsi::number_param("tol", 1e-10, "absolute and relative tolerance per substep")
-                           .range(1e-16, 1e-1),
+                           .range(tsi::smallest_tolerance, 1e-1),
                        tsi::number_param("substeps_per_period", 8.0,
                                          "fewest substeps per period of an explicit fast time "
                                          "dependence (filtered problem): larger steps alias")

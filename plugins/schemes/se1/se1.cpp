@@ -13,6 +13,7 @@
 namespace {
 
 namespace algebra = tsi::algebra;
+using tsi::Real;
 using tsi::Complex;
 using tsi::Vector;
 
@@ -20,7 +21,7 @@ using tsi::Vector;
 // two-scale problem without a remainder: tsi::Diagonal).
 struct Coefficients {
   tsi::Diagonal e_half, b_half, e_full, b_full;
-  Coefficients(const tsi::Problem& problem, double h) {
+  Coefficients(const tsi::Problem& problem, Real h) {
     const tsi::Diagonal& lambda = problem.linear_multipliers();
     tsi::diagonal_function(lambda, 0.5 * h, [](Complex z) { return std::exp(z); }, e_half);
     tsi::diagonal_function(lambda, 0.5 * h, [h](Complex z) { return 0.5 * h * tsi::phi1(z); }, b_half);
@@ -31,7 +32,7 @@ struct Coefficients {
 
 class Se1 final : public tsi::Stepper {
  public:
-  Se1(tsi::Problem& problem, double h, const tsi::FixedPointOptions& options)
+  Se1(tsi::Problem& problem, Real h, const tsi::FixedPointOptions& options)
       : Stepper(problem, h),
         c_(problem, h),
         solver_(tsi::make_fixed_point_solver(options)),
@@ -45,13 +46,13 @@ class Se1 final : public tsi::Stepper {
   // The stage's base e^{z/2} U^n is stored for small states only (ProblemLayout::
   // stores_stage_bases); otherwise each sweep forms it again in the same pass (the same
   // products, rounded the same way), one vector less.
-  void step(double t, Vector& y) override {
+  void step(Real t, Vector& y) override {
     // Starting guess: the stage with the previous step's N(U^{n-1/2}), an O(h^2) predictor.
     if (guess_.from_previous())
       algebra::diagonal_combination(c_.e_half, y, c_.b_half, n_half_, y_half_);
     else
       algebra::diagonal_multiply(c_.e_half, y, y_half_);
-    const double t_half = t + 0.5 * h_;
+    const Real t_half = t + 0.5 * h_;
     if (base_.size()) algebra::diagonal_multiply(c_.e_half, y, base_);
     solver_->solve(y_half_, [&](const Vector& x, Vector& out) {
       problem_.nonlinear(t_half, x, n_half_);

@@ -15,6 +15,7 @@
 namespace {
 
 namespace algebra = tsi::algebra;
+using tsi::Real;
 using tsi::Complex;
 using tsi::Vector;
 
@@ -25,7 +26,7 @@ class Se2 final : public tsi::Stepper {
     int nodes;
   };
 
-  Se2(tsi::Problem& problem, double h, const Settings& settings)
+  Se2(tsi::Problem& problem, Real h, const Settings& settings)
       : Stepper(problem, h),
         solver_(tsi::make_fixed_point_solver(settings.options)),
         guess_(settings.options),
@@ -42,7 +43,7 @@ class Se2 final : public tsi::Stepper {
 
   // The base e^z U^n is not stored: each sweep forms it again in its last pass (the same
   // products, rounded the same way), one vector less.
-  void step(double t, Vector& y) override {
+  void step(Real t, Vector& y) override {
     // Starting guess: the previous step's averaged N, an O(h^2) predictor.
     if (guess_.from_previous())
       algebra::diagonal_combination(e_, y, b_, average_, next_);
@@ -52,7 +53,7 @@ class Se2 final : public tsi::Stepper {
     solver_->solve(next_, [&](const Vector& x, Vector& out) {
       algebra::set_zero(y.size(), average_);
       for (size_t i = 0; i < rule_.nodes.size(); ++i) {
-        const double rho = rule_.nodes[i];
+        const Real rho = rule_.nodes[i];
         algebra::axpby(1.0 - rho, y, rho, x, out);
         problem_.nonlinear(t + rho * h_, out, n_);
         algebra::axpy(rule_.weights[i], n_, average_);

@@ -9,13 +9,14 @@
 
 namespace {
 
+using tsi::Real;
 using tsi::Vector;
 
 class Strang final : public tsi::Stepper {
  public:
-  Strang(tsi::Problem& problem, double h, std::monostate) : Stepper(problem, h) {}
+  Strang(tsi::Problem& problem, Real h, std::monostate) : Stepper(problem, h) {}
 
-  void step(double t, Vector& y) override {
+  void step(Real t, Vector& y) override {
     problem_.linear_flow(0.5 * h_, y);
     problem_.nonlinear_flow(t, h_, y);
     problem_.linear_flow(0.5 * h_, y);
