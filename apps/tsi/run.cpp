@@ -229,9 +229,9 @@ Json state_to_json(const Vector& x, bool complex_state) {
   Json out = Json::array();
   for (Index i = 0; i < x.size(); ++i) {
     if (complex_state)
-      out.push_back({x(i).real(), x(i).imag()});
+      out.push_back({to_double(x(i).real()), to_double(x(i).imag())});
     else
-      out.push_back(x(i).real());
+      out.push_back(to_double(x(i).real()));
   }
   return out;
 }
@@ -570,7 +570,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
           std::vector<std::uint64_t> shape;
           for (const Index d : model->physical_shape()) shape.push_back(static_cast<std::uint64_t>(d));
           write_npy(stream_dir + "/state.npy", x, model->is_complex(), shape);
-          result["state"] = {{"file", "state.npy"}, {"t", t}, {"step", n}};
+          result["state"] = {{"file", "state.npy"}, {"t", to_double(t)}, {"step", n}};
           checkpoint(n, to_double(t));
         }
       }
@@ -687,8 +687,8 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
       result["message"] = outcome.message;
       return outcome;
     }
-    Json error = {{"relative", model->error_norm(x_here - ref.x) / model->error_norm(ref.x)},
-                  {"absolute", model->error_norm(x_here - ref.x)},
+    Json error = {{"relative", to_double(model->error_norm(x_here - ref.x) / model->error_norm(ref.x))},
+                  {"absolute", to_double(model->error_norm(x_here - ref.x))},
                   {"reference", ref.settings}};
     error["reference"]["wall_seconds"] = ref.wall_seconds;
     error["reference"]["estimated_relative_accuracy"] =

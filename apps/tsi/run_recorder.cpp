@@ -246,18 +246,18 @@ Json RunRecorder::invariants_json() const {
   Json out = Json::object();
   const char* names[3] = {"H", "I", "m"};
   for (int k = 0; hamiltonian_ && k < 3; ++k)
-    out[names[k]] = {{"initial", tracks_[k].initial},
-                     {"final", tracks_[k].final},
+    out[names[k]] = {{"initial", to_double(tracks_[k].initial)},
+                     {"final", to_double(tracks_[k].final)},
                      {"max_rel_error", tracks_[k].max_rel_error}};
   for (const auto& d : declared_) {
     if (!d.invariant.conserved) {  // a diagnostic: its range (no column of changes)
-      out[d.invariant.name] = {{"initial", d.initial},     {"final", d.final},
-                               {"min", d.min},             {"max", d.max},
+      out[d.invariant.name] = {{"initial", to_double(d.initial)}, {"final", to_double(d.final)},
+                               {"min", to_double(d.min)},         {"max", to_double(d.max)},
                                {"conserved", false},       {"description", d.invariant.description}};
       continue;
     }
-    out[d.invariant.name] = {{"initial", d.initial},
-                             {"final", d.final},
+    out[d.invariant.name] = {{"initial", to_double(d.initial)},
+                             {"final", to_double(d.final)},
                              {"max_change", d.max_change},
                              {"change", d.relative ? "relative" : "absolute"},
                              {"column", d.column},

@@ -11,6 +11,7 @@
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -21,7 +22,7 @@ namespace tsi::app {
 #ifdef TSI_WITH_MPI
 namespace {
 
-// The build's Real as MPI sees it.
+// The build's Real as MPI sees it (a quad build refuses to split: MPI has no float128).
 const MPI_Datatype mpi_real = std::is_same_v<Real, double> ? MPI_DOUBLE : MPI_LONG_DOUBLE;
 
 class MpiWorld final : public Collective {
@@ -74,7 +75,12 @@ class MpiWorld final : public Collective {
 
 }  // namespace
 
-std::unique_ptr<Collective> start_split_processes() { return std::make_unique<MpiWorld>(); }
+std::unique_ptr<Collective> start_split_processes() {
+  if (std::numeric_limits<Real>::digits > 64)
+    throw ConfigError("--split", "this tsi is a quad build (TSI_PRECISION=quad), and MPI reduces no quadruple "
+                                 "precision; split runs need a double or long-double build");
+  return std::make_unique<MpiWorld>();
+}
 #else
 std::unique_ptr<Collective> start_split_processes() {
   throw ConfigError("--split", "this tsi was built without MPI; install libopenmpi-dev and openmpi-bin and "

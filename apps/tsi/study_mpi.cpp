@@ -77,7 +77,7 @@ Json receive(int source, int tag) {
 
 Json reference_to_json(const ReferenceSolution& r) {
   Json re = Json::array(), im = Json::array();
-  for (Index i = 0; i < r.x.size(); ++i) re.push_back(r.x(i).real()), im.push_back(r.x(i).imag());
+  for (Index i = 0; i < r.x.size(); ++i) re.push_back(to_double(r.x(i).real())), im.push_back(to_double(r.x(i).imag()));
   return {{"re", re}, {"im", im}, {"wall_seconds", r.wall_seconds},
           {"accuracy", std::isnan(r.accuracy) ? Json() : Json(r.accuracy)}, {"settings", r.settings}};
 }

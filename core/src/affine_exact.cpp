@@ -38,6 +38,16 @@ QuadMatrix product(const QuadMatrix& x, const QuadMatrix& y) {
 
 Quad magnitude(Quad x) { return x < Quad(0) ? -x : x; }
 
+// A Real as a Quad and back: exact in every precision (quad's Real holds a __float128).
+Quad quad_of(Real x) {
+#if defined(TSI_PRECISION_QUAD)
+  return x.backend().value();
+#else
+  return Quad(x);
+#endif
+}
+Real real_of(Quad x) { return Real(x); }
+
 double max_abs(const QuadMatrix& x) {
   Quad m = 0;
   for (const Quad e : x.v) m = magnitude(e) > m ? magnitude(e) : m;
@@ -86,9 +96,9 @@ ExactSolution::Value affine_exact_solution(const Matrix& A, Real eps, const Affi
   // Complex numbers as real pairs: the augmented Z of size m = n + 2 acts on (Re z, Im z).
   const Index m = n + 2, size = 2 * m;
   QuadMatrix Z(size);
-  const Quad inverse_eps = Quad(1) / Quad(eps), time = Quad(t);
+  const Quad inverse_eps = Quad(1) / quad_of(eps), time = quad_of(t);
   auto set = [&](Index i, Index j, Complex c) {
-    const Quad re = Quad(c.real()) * time, im = Quad(c.imag()) * time;
+    const Quad re = quad_of(c.real()) * time, im = quad_of(c.imag()) * time;
     Z(i, j) = re;
     Z(i + m, j + m) = re;
     Z(i, j + m) = -im;
@@ -98,10 +108,10 @@ ExactSolution::Value affine_exact_solution(const Matrix& A, Real eps, const Affi
     for (Index j = 0; j < n; ++j) {
       set(i, j, f.B(i, j));
       // A / eps in quad: the division is exact to quad, not rounded to double first.
-      Z(i, j) += Quad(A(i, j).real()) * inverse_eps * time;
-      Z(i + m, j + m) += Quad(A(i, j).real()) * inverse_eps * time;
-      Z(i, j + m) -= Quad(A(i, j).imag()) * inverse_eps * time;
-      Z(i + m, j) += Quad(A(i, j).imag()) * inverse_eps * time;
+      Z(i, j) += quad_of(A(i, j).real()) * inverse_eps * time;
+      Z(i + m, j + m) += quad_of(A(i, j).real()) * inverse_eps * time;
+      Z(i, j + m) -= quad_of(A(i, j).imag()) * inverse_eps * time;
+      Z(i + m, j) += quad_of(A(i, j).imag()) * inverse_eps * time;
     }
     set(i, n, f.a(i));
     set(i, n + 1, f.b(i));
@@ -109,8 +119,8 @@ ExactSolution::Value affine_exact_solution(const Matrix& A, Real eps, const Affi
   set(n, n + 1, Complex(1));
   std::vector<Quad> z0(static_cast<std::size_t>(size), Quad(0));
   for (Index i = 0; i < n; ++i) {
-    z0[static_cast<std::size_t>(i)] = u0(i).real();
-    z0[static_cast<std::size_t>(i + m)] = u0(i).imag();
+    z0[static_cast<std::size_t>(i)] = quad_of(u0(i).real());
+    z0[static_cast<std::size_t>(i + m)] = quad_of(u0(i).imag());
   }
   z0[static_cast<std::size_t>(n + 1)] = 1;
   auto solve = [&](int extra) {
@@ -125,12 +135,12 @@ ExactSolution::Value affine_exact_solution(const Matrix& A, Real eps, const Affi
   ExactSolution::Value out{Vector(n), 0.0};
   for (Index i = 0; i < n; ++i) {
     const auto re = static_cast<std::size_t>(i), im = static_cast<std::size_t>(i + m);
-    out.x(i) = Complex(static_cast<Real>(z[re]), static_cast<Real>(z[im]));
+    out.x(i) = Complex(real_of(z[re]), real_of(z[im]));
     norm2 += z[re] * z[re] + z[im] * z[im];
     diff2 += (z[re] - check[re]) * (z[re] - check[re]) + (z[im] - check[im]) * (z[im] - check[im]);
   }
-  const Real norm = std::sqrt(static_cast<Real>(norm2));
-  const Real spread = norm > 0 ? std::sqrt(static_cast<Real>(diff2)) / norm : 0;
+  const Real norm = std::sqrt(real_of(norm2));
+  const Real spread = norm > 0 ? std::sqrt(real_of(diff2)) / norm : 0;
   out.accuracy = std::max(spread, std::numeric_limits<Real>::epsilon() / 2);
   return out;
 }

@@ -35,7 +35,7 @@ std::vector<Complex> InterpolatoryWeights::operator()(Real kappa, Complex z) con
     if (m > 0) factorial *= m, power *= kappa;
     moments[m] = power * factorial * phi(m + 1, kappa * z);
   }
-  std::vector<Complex> w(r, 0.0);
+  std::vector<Complex> w(r, Complex(0));
   for (int j = 0; j < r; ++j)
     for (int m = 0; m < r; ++m) w[j] += monomials_[j][m] * moments[m];
   return w;

@@ -141,7 +141,7 @@ void FftBatch::transform(const Complex* from, Complex* to, int direction, Real s
     void* plan = whole ? plans_[direction] : part_plans_[2 * static_cast<std::size_t>(part) + direction];
     // The in-place plans run on `to` itself where it has the alignment they were made with:
     // one copy (from -> to) instead of two through the buffer.
-    const auto alignment = [](const Complex* p) { return TSI_FFTW(alignment_of)(reinterpret_cast<Real*>(const_cast<Complex*>(p))); };
+    const auto alignment = [](const Complex* p) { return TSI_FFTW(alignment_of)(detail::fftw_real(reinterpret_cast<const Real*>(p))); };
     const bool on_to = to != buffer_ && alignment(to + r0) == alignment(buffer_ + r0);
     if (rows == howmany_) {  // the whole array: contiguous passes (a block of rows is strided)
       Complex* work = on_to ? to : buffer_;
@@ -204,7 +204,7 @@ void FftBatch::transform(const Complex* from, Complex* to, int direction, Real s
 
 void FftBatch::forward() {
   forward_unnormalised();
-  data() *= 1.0 / n_;
+  data() *= Real(1) / n_;
 }
 
 // The buffer's own transforms: transform() from the buffer into itself (allocated first).
@@ -240,7 +240,7 @@ RealFftBatch::RealFftBatch(int n, int howmany, int parts)
   if (threads_ready) TSI_FFTW(plan_with_nthreads)(1);  // the callers' threads split the rows
   // FFTW_ESTIMATE plans never touch the arrays they are made with, and FFTW_UNALIGNED plans
   // run on any: small stand-ins serve for planning, the callers' arrays at execution.
-  Real* real_standin = TSI_FFTW(alloc_real)(2);
+  detail::FftwReal* real_standin = TSI_FFTW(alloc_real)(2);
   TSI_FFTW(complex)* complex_standin = TSI_FFTW(alloc_complex)(2);
   bool planned = real_standin && complex_standin;
   const unsigned flags = FFTW_ESTIMATE | FFTW_UNALIGNED;
@@ -277,12 +277,12 @@ void RealFftBatch::transform(const void* from, void* to, int direction, int part
   const int last = part < 0 ? howmany_ : part_rows_[static_cast<std::size_t>(part) + 1];
   const auto execute = [&](void* plan, int row) {
     if (direction == 0)
-      TSI_FFTW(execute_dft_r2c)(as_plan(plan), const_cast<Real*>(static_cast<const Real*>(from)) + row,
+      TSI_FFTW(execute_dft_r2c)(as_plan(plan), detail::fftw_real(static_cast<const Real*>(from) + row),
                            reinterpret_cast<TSI_FFTW(complex)*>(static_cast<Complex*>(to) + row));
     else  // FFTW_PRESERVE_INPUT: the coefficients are only read
       TSI_FFTW(execute_dft_c2r)(as_plan(plan),
                            reinterpret_cast<TSI_FFTW(complex)*>(const_cast<Complex*>(static_cast<const Complex*>(from)) + row),
-                           static_cast<Real*>(to) + row);
+                           detail::fftw_real(static_cast<Real*>(to) + row));
   };
   int row = first;
   for (; row + block_ <= last; row += block_) execute(block_plans_[direction], row);

@@ -24,7 +24,7 @@ void Field::derivative(const RealVector&, ConstMatrixRef, ConstMatrixRef, Matrix
 
 namespace {
 
-constexpr Real two_pi = 2 * std::numbers::pi_v<Real>;
+TSI_REAL_CONSTEXPR Real two_pi = 2 * std::numbers::pi_v<Real>;
 
 // A JSON value as a short text for a message (a large matrix is cut).
 std::string shown(const Json& v) {
@@ -320,12 +320,13 @@ class QuickstartField final : public Field {
 class LinearTestField final : public Field {
  public:
   LinearTestField() {
-    terms_.B = Matrix(4, 4);
-    terms_.B << 0.12, -0.78, 0.91, 0.34, -0.45, 0.56, 0.03, 0.54, -0.67, 0.09, 0.18, 0.89, -0.91, -0.56, 0.11, -0.56;
-    terms_.a = Vector(4);
-    terms_.a << 0.12, -0.98, 0.45, 0.26;
-    terms_.b = Vector(4);
-    terms_.b << -0.04, 0.48, 0.23, -0.87;
+    // The peer's decimal numbers as doubles, whatever Real is: the same problem in every precision.
+    terms_.B = (Eigen::Matrix4d() << 0.12, -0.78, 0.91, 0.34, -0.45, 0.56, 0.03, 0.54, -0.67, 0.09, 0.18, 0.89, -0.91,
+                -0.56, 0.11, -0.56)
+                   .finished()
+                   .cast<Complex>();
+    terms_.a = Eigen::Vector4d(0.12, -0.98, 0.45, 0.26).cast<Complex>();
+    terms_.b = Eigen::Vector4d(-0.04, 0.48, 0.23, -0.87).cast<Complex>();
   }
   void evaluate(const RealVector& t, ConstMatrixRef u, MatrixRef out) const override {
     out.noalias() = terms_.B * u;
@@ -361,8 +362,7 @@ void register_matrix_model(Registry& registry) {
   quickstart.info.summary = "HOODESolver.jl's quickstart f(u) = (0, u4, 2 u1 u2, -u2 - u1^2 + u2^2), 4 entries, "
                             "default u0 (0.55, 0.12, 0.03, 0.89)";
   quickstart.dim = 4;
-  quickstart.initial_value = Vector(4);
-  quickstart.initial_value << 0.55, 0.12, 0.03, 0.89;
+  quickstart.initial_value = Eigen::Vector4d(0.55, 0.12, 0.03, 0.89).cast<Complex>();
   quickstart.create = [](Index) { return std::make_shared<QuickstartField>(); };
   registry.add_field(std::move(quickstart));
 
@@ -372,8 +372,7 @@ void register_matrix_model(Registry& registry) {
                         "(-0.34, 0.78, 0.67, -5.6); exact solution (reference.scheme \"exact\")";
   linear.dim = 4;
   linear.time_dependent = true;
-  linear.initial_value = Vector(4);
-  linear.initial_value << -0.34, 0.78, 0.67, -5.6;
+  linear.initial_value = Eigen::Vector4d(-0.34, 0.78, 0.67, -5.6).cast<Complex>();
   linear.create = [](Index) { return std::make_shared<LinearTestField>(); };
   registry.add_field(std::move(linear));
 

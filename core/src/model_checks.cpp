@@ -99,7 +99,7 @@ class ModelChecks {
   Json model_section(Real eps) const {
     Json m = options_.model_params;
     m["name"] = entry_.info.name;
-    m["eps"] = eps;
+    m["eps"] = to_double(eps);
     return m;
   }
   /// The scheme's traits with the user's --set scheme parameters (eab's order, ...).
@@ -148,7 +148,7 @@ class ModelChecks {
                     int max_iter) const {
     Json scheme_section = {{"name", scheme.info.name}};
     for (const auto& p : scheme.info.params) {
-      if (p.name == "tol") scheme_section["tol"] = tol;
+      if (p.name == "tol") scheme_section["tol"] = to_double(tol);
       if (p.name == "max_iter") scheme_section["max_iter"] = max_iter;
       if (options_.scheme_params.contains(p.name)) scheme_section[p.name] = options_.scheme_params[p.name];
     }
@@ -425,7 +425,7 @@ void ModelChecks::orders(const SchemeEntry& scheme, Real eps, const std::vector<
   // One eps: its errors and observed order, for information; the verdict is the envelope's.
   const OrderFit fit = fit_order(doubles(step_sizes(options_.steps)), doubles(errs), to_double(reference_floor(eps, fit_floor(traits_of(scheme)))));
   std::string row;
-  for (const Real e : errs) row += fmt::format(" {:>9.2e}", e);
+  for (const Real& e : errs) row += fmt::format(" {:>9.2e}", e);
   const std::string observed = !fit.finite ? "inf" : fit.measurable ? fmt::format("{:.2f}", fit.order) : "-";
   const std::string resonant = resonant_steps(options_.steps, eps, 2.0);
   fmt::print(out_, "    {:<5} {:<12} {:<10.4g}{} {:>6}{}\n", "", scheme.info.name, eps, row, observed,
@@ -450,7 +450,7 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& s
   };
   const auto envelope_over = [&](const std::vector<long>& steps) {
     Envelope env{std::vector<Real>(steps.size(), 0.0), std::vector<Real>(steps.size(), 0.0), 0.0};
-    for (const Real eps : sample) {
+    for (const Real& eps : sample) {
       const std::vector<Real> errs =
           steps == options_.steps ? errors_at(scheme, eps, references.at(eps))
                                   : errors(scheme, eps, references.at(eps), steps, factor);
@@ -471,7 +471,7 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& s
   const Envelope env = envelope_over(options_.steps);
   const OrderFit fit = fit_order(doubles(step_sizes(options_.steps)), doubles(env.worst), to_double(base_floor));
   std::string row;
-  for (const Real e : env.worst) row += e > 0.0 ? fmt::format(" {:>9.2e}", e) : fmt::format(" {:>9}", "(ref)");
+  for (const Real& e : env.worst) row += e > 0.0 ? fmt::format(" {:>9.2e}", e) : fmt::format(" {:>9}", "(ref)");
   const std::string observed = !fit.finite ? "inf" : fit.measurable ? fmt::format("{:.2f}", fit.order) : "-";
   std::string declared = fmt::format(">= {} - {:g}", q, margin);
   if (q < traits.order)
@@ -571,7 +571,7 @@ std::vector<Real> eps_sample(const std::vector<Real>& epsilons, const std::vecto
   std::sort(out.begin(), out.end(), std::greater<>());
   // Equal eps once (to a relative 1e-9: the given ones and the log grid's ends coincide).
   std::vector<Real> unique;
-  for (const Real e : out)
+  for (const Real& e : out)
     if (unique.empty() || std::abs(unique.back() - e) > 1e-9 * e) unique.push_back(e);
   return unique;
 }
@@ -582,7 +582,7 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
   std::map<Real, Vector> references;
   fmt::print(out_, "\n  reference: rk78 on the filtered problem, tol {:g} (its accuracy: the change from tol {:g}), T = {:g}\n",
              reference_tol, 10.0 * reference_tol, t_end);
-  for (const Real eps : sample) {
+  for (const Real& eps : sample) {
     const auto m = model(eps);
     const Vector u0 = m->initial_value();
     const Vector u = reference(m, u0);
@@ -624,7 +624,7 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
   fmt::print(out_, " {:>6}  {}\n", "order", "expected");
   for (const auto* scheme : schemes) {
     try {
-      for (const Real eps : epsilons) orders(*scheme, eps, errors_at(*scheme, eps, references.at(eps)));
+      for (const Real& eps : epsilons) orders(*scheme, eps, errors_at(*scheme, eps, references.at(eps)));
       envelope(*scheme, sample, references);
     } catch (const std::exception& e) {
       report(false, fmt::format("{:<12} {:<10} {}", scheme->info.name, "max", e.what()),
@@ -639,7 +639,7 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
                  fmt::format("symmetry: a step h = {:g}, then -h (symmetric schemes)", symmetry_step),
                  "value", "limit");
     any_symmetric = true;
-    for (const Real eps : epsilons) {
+    for (const Real& eps : epsilons) {
       try {
         symmetry(*scheme, eps);
       } catch (const std::exception& e) {

@@ -3,16 +3,18 @@
 #include <array>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
 namespace tsi {
 namespace {
 
-// Below this modulus the Taylor series is used: 1/(k+2)! < 2^-64 for k >= 19, and the
-// terms fall at least geometrically, so 24 terms leave the sum exact to rounding.
+// Below this modulus the Taylor series is used: 1/(k+2)! < 2^-64 for k >= 19 and < 2^-113
+// for k >= 32, and the terms fall at least geometrically, so 24 terms (34 in quad) leave
+// the sum exact to rounding.
 constexpr Real series_radius = 1.0;
-constexpr int series_terms = 24;
+constexpr int series_terms = std::numeric_limits<Real>::digits > 64 ? 34 : 24;
 
 // 1/n! for n = 0 .. series_terms + 2, each from the previous by one division.
 const std::array<Real, series_terms + 3>& inverse_factorials() {
@@ -28,7 +30,7 @@ const std::array<Real, series_terms + 3>& inverse_factorials() {
 // sum_{k>=0} z^k / (k + shift)!  for |z| <= 1, by Horner from the tail.
 Complex series(Complex z, int shift) {
   const auto& c = inverse_factorials();
-  Complex sum = 0.0;
+  Complex sum(0);
   for (int k = series_terms; k >= 0; --k) sum = sum * z + c[k + shift];
   return sum;
 }
@@ -63,7 +65,7 @@ Complex phi(int k, Complex z) {
     constexpr int terms = 64;
     Real inv = 1.0;  // 1 / (terms + k)!
     for (int n = 2; n <= terms + k; ++n) inv /= n;
-    Complex sum = 0.0;
+    Complex sum(0);
     for (int m = terms; m >= 0; --m) {
       sum = sum * z + inv;
       inv *= (m + k);  // 1/(m + k - 1)!

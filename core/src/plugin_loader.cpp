@@ -90,9 +90,11 @@ void check_layout(const std::string& path, const TsiPluginLayout& theirs) {
                       " AddressSanitizer, this tsi " + (ours.address_sanitizer ? "with" : "without") +
                       " it (Eigen allocates through another allocator under ASan, and vectors cross the "
                       "plugin boundary: build both the same way)");
-  if (theirs.real.size != ours.real.size || theirs.real.align != ours.real.align)
-    throw PluginError(path + ": its real type (tsi::Real) is " + describe(theirs.real) + ", this tsi's is " +
-                      describe(ours.real) + " (" TSI_PRECISION_NAME
+  if (theirs.real.size != ours.real.size || theirs.real.align != ours.real.align ||
+      theirs.real_digits != ours.real_digits)
+    throw PluginError(path + ": its real type (tsi::Real) is " + describe(theirs.real) + " with a " +
+                      std::to_string(theirs.real_digits) + "-bit significand, this tsi's is " + describe(ours.real) +
+                      " with " + std::to_string(ours.real_digits) + " bits (" TSI_PRECISION_NAME
                       "): built for another TSI_PRECISION; rebuild the plugin against this tsi");
 }
 

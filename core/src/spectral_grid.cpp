@@ -239,7 +239,7 @@ RealGridTransforms::RealGridTransforms(const SpectralGrid& grid, Index columns, 
   const auto n_values = static_cast<std::size_t>(points_) * static_cast<std::size_t>(columns_);
   const auto n_coefficients = static_cast<std::size_t>(half_points_) * static_cast<std::size_t>(columns_);
   std::lock_guard<std::mutex> lock(detail::fftw_planner_mutex());
-  values_ = TSI_FFTW(alloc_real)(n_values);
+  values_ = detail::tsi_real(TSI_FFTW(alloc_real)(n_values));
   spectrum_ = reinterpret_cast<Complex*>(TSI_FFTW(alloc_complex)(n_coefficients));
   const auto release = [this] {
     for (void* plan : plans_)
@@ -257,23 +257,23 @@ RealGridTransforms::RealGridTransforms(const SpectralGrid& grid, Index columns, 
   auto* out = reinterpret_cast<TSI_FFTW(complex)*>(spectrum_);
   if (leading_) {  // the last direction of one field: its rows
     const int rows = static_cast<int>(points_ / n_last_);
-    plans_[0] = TSI_FFTW(plan_many_dft_r2c)(1, &n_last_, rows, values_, nullptr, 1, n_last_, out, nullptr, 1, half,
+    plans_[0] = TSI_FFTW(plan_many_dft_r2c)(1, &n_last_, rows, detail::fftw_real(values_), nullptr, 1, n_last_, out, nullptr, 1, half,
                                        FFTW_ESTIMATE);
-    plans_[1] = TSI_FFTW(plan_many_dft_c2r)(1, &n_last_, rows, out, nullptr, 1, half, values_, nullptr, 1, n_last_,
+    plans_[1] = TSI_FFTW(plan_many_dft_c2r)(1, &n_last_, rows, out, nullptr, 1, half, detail::fftw_real(values_), nullptr, 1, n_last_,
                                        FFTW_ESTIMATE);
   } else {
     const int dist_values = static_cast<int>(points_), dist_spectrum = static_cast<int>(half_points_);
-    plans_[0] = TSI_FFTW(plan_many_dft_r2c)(grid.dims(), shape.data(), static_cast<int>(columns_), values_, nullptr, 1,
+    plans_[0] = TSI_FFTW(plan_many_dft_r2c)(grid.dims(), shape.data(), static_cast<int>(columns_), detail::fftw_real(values_), nullptr, 1,
                                        dist_values, out, nullptr, 1, dist_spectrum, FFTW_ESTIMATE);
     plans_[1] = TSI_FFTW(plan_many_dft_c2r)(grid.dims(), shape.data(), static_cast<int>(columns_), out, nullptr, 1,
-                                       dist_spectrum, values_, nullptr, 1, dist_values, FFTW_ESTIMATE);
+                                       dist_spectrum, detail::fftw_real(values_), nullptr, 1, dist_values, FFTW_ESTIMATE);
   }
   if (detail::fftw_threads_ready()) TSI_FFTW(plan_with_nthreads)(1);
   if (!plans_[0] || !plans_[1]) {
     release();
     throw Error(fmt::format("RealGridTransforms: FFTW could not plan {} x {} transforms", grid.describe(), columns));
   }
-  std::fill(values_, values_ + n_values, 0.0);
+  std::fill(values_, values_ + n_values, Real(0));
   std::fill(spectrum_, spectrum_ + n_coefficients, Complex(0.0));
 }
 
@@ -292,7 +292,7 @@ void RealGridTransforms::forward() {
   for (Index j = 0; j < columns_; ++j) {
     Complex* field = spectrum_ + j * half_points_;
     // Columns keep the buffers' alignment: points_ even (doubles) and 16-byte complex values.
-    TSI_FFTW(execute_dft_r2c)(plan, values_ + j * points_, reinterpret_cast<TSI_FFTW(complex)*>(field));
+    TSI_FFTW(execute_dft_r2c)(plan, detail::fftw_real(values_ + j * points_), reinterpret_cast<TSI_FFTW(complex)*>(field));
     leading_->transform(field, 0);
   }
 }
@@ -303,7 +303,7 @@ void RealGridTransforms::backward() {
   for (Index j = 0; j < columns_; ++j) {
     Complex* field = spectrum_ + j * half_points_;
     leading_->transform(field, 1);
-    TSI_FFTW(execute_dft_c2r)(plan, reinterpret_cast<TSI_FFTW(complex)*>(field), values_ + j * points_);
+    TSI_FFTW(execute_dft_c2r)(plan, reinterpret_cast<TSI_FFTW(complex)*>(field), detail::fftw_real(values_ + j * points_));
   }
 }
 

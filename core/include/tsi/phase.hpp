@@ -6,7 +6,7 @@
 
 namespace tsi {
 
-inline constexpr Real two_pi = 2 * std::numbers::pi_v<Real>;
+inline TSI_REAL_CONSTEXPR Real two_pi = 2 * std::numbers::pi_v<Real>;
 
 /// The fast phase t/eps reduced to [0, 2*pi), with a rounding error of the order of the
 /// result's ulp: neither the quotient's rounding (ulp(t/eps)) nor the number of periods enters.

@@ -1,5 +1,6 @@
 #pragma once
 #include <cstdint>
+#include <limits>
 #include <string>
 
 #include "tsi/export.hpp"
@@ -48,8 +49,10 @@ struct TsiPluginLayout {
   /// memory one side allocates the other frees, so both must agree.
   std::uint32_t address_sanitizer;
   /// tsi::Real, the build's precision (TSI_PRECISION): a double plugin's states and step sizes
-  /// are not a long-double tsi's.
+  /// are not a quad tsi's. Its size and alignment, and its significand's bits (53, 64 or 113:
+  /// long double and quad are both 16 bytes).
   TsiTypeLayout real;
+  std::uint32_t real_digits;
 };
 
 struct TsiPluginInfo {
@@ -94,7 +97,8 @@ constexpr TsiPluginLayout tsi_plugin_layout() {
 #else
           0u,
 #endif
-          layout_of<tsi::Real>()};
+          layout_of<tsi::Real>(),
+          static_cast<std::uint32_t>(std::numeric_limits<tsi::Real>::digits)};
 }
 
 /// Name of the entry point the loader looks up.

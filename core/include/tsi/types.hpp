@@ -2,6 +2,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <complex>
+#include <limits>
 
 #include "tsi/precision.hpp"
 
@@ -32,8 +33,14 @@ inline Real inner(const Vector& u, const Vector& v) { return u.dot(v).real(); }
 inline Real max_norm(const Vector& v) { return v.size() ? std::sqrt(v.cwiseAbs2().maxCoeff()) : Real(0); }
 
 /// The smallest relative tolerance an adaptive reference solver takes: 1e-16 in a double
-/// build, 1e-20 in a long-double one (each just below its unit roundoff).
-inline constexpr double smallest_tolerance = sizeof(Real) == sizeof(double) ? 1e-16 : 1e-20;
+/// build, 1e-20 in a long-double one, 1e-34 in quad (each just below its unit roundoff).
+inline constexpr double smallest_tolerance =
+    std::numeric_limits<Real>::digits > 64 ? 1e-34 : std::numeric_limits<Real>::digits > 53 ? 1e-20 : 1e-16;
+
+/// The real part of a real or complex value: a kernel templated on real and complex tau grids
+/// reads either (std::real takes no class type such as quad's Real).
+inline Real real_part(const Real& x) { return x; }
+inline Real real_part(const Complex& z) { return z.real(); }
 
 /// A Real as a double: the figures a run records (errors, invariants, norms) are written
 /// as doubles, whose range holds every error an extended build reaches.

@@ -18,10 +18,10 @@ void require_linear_to_physical(const Model& model) {
   for (Index i = 0; i < a.size(); ++i) {
     a(i) = 0.1 + 0.9 * static_cast<Real>(i % 7) / 7.0;
     const Real w = 0.3 + 0.7 * static_cast<Real>(i + 1) / static_cast<Real>(a.size());
-    b(i) = model.is_complex() ? Complex(w, 0.5 * w) : Complex(w, 0.0);
+    b(i) = model.is_complex() ? Complex(w, Real(0.5) * w) : Complex(w, 0);
   }
-  const Vector lhs = model.to_physical(a + 2.0 * b);
-  const Vector rhs = model.to_physical(a) + 2.0 * model.to_physical(b);
+  const Vector lhs = model.to_physical(a + Real(2) * b);
+  const Vector rhs = model.to_physical(a) + Real(2) * model.to_physical(b);
   const Real scale = std::max(max_norm(lhs), max_norm(rhs));
   if (!(max_norm(lhs - rhs) <= 1e-10 * std::max<Real>(scale, 1)))
     throw ConfigError("reformulation.variables",

@@ -188,7 +188,7 @@ Matrix PreparedData::central_phi(const Vector& u, int k) {
     if (remainder_.size()) g += remainder_.cwiseProduct(u);
     const Real d = std::pow(eps_, 0.25 * (k - 2));
     const auto at = [&](Real shift) { return central_phi(u + shift * d * g, k - 1); };
-    const Matrix derivative = (8.0 * (at(1.0) - at(-1.0)) - (at(2.0) - at(-2.0))) / (12.0 * d);
+    const Matrix derivative = (Real(8) * (at(1) - at(-1)) - (at(2) - at(-2))) / (12 * d);
     rhs -= derivative;
   }
   return eps_ * grid_.apply_A(rhs);

@@ -226,7 +226,7 @@ Matrix TauGrid::to_coefficients(Matrix grid) {
     grid.resize(0, 0);
     Matrix c(dim_, columns_);
     real_fft_->forward_unnormalised(values.data(), c.data());
-    c *= 1.0 / n_tau_;
+    c *= Real(1) / n_tau_;
     return all_modes(c);
   }
   fft_->transform(grid.data(), grid.data(), 0, 1.0 / n_tau_);

@@ -126,8 +126,8 @@ class ChargedParticle final : public tsi::Model,
       for (Index i = 0; i < m; ++i) {
         const Index j = j0 + i;
         const Real c = cos(j), s = sin(j);
-        const Real q1 = std::real(u(0, j)), q2 = std::real(u(1, j)), p1 = std::real(u(2, j)),
-                     p2 = std::real(u(3, j));
+        const Real q1 = tsi::real_part(u(0, j)), q2 = tsi::real_part(u(1, j)), p1 = tsi::real_part(u(2, j)),
+                     p2 = tsi::real_part(u(3, j));
         const Real a1 = c * q1 + s * p1, a2 = c * q2 + s * p2;
         x1[i] = c * a1 + s * a2;  // q of e^{JM tau} u
         x2[i] = -s * a1 + c * a2;
@@ -222,9 +222,7 @@ class ChargedParticle final : public tsi::Model,
   }
 
   Vector initial_value() const override {
-    Vector x(4);
-    x << 0.8, 0.9, 0.5, 0.6;
-    return from_physical(x);
+    return from_physical(Eigen::Vector4d(0.8, 0.9, 0.5, 0.6).cast<Complex>());
   }
 
   Index physical_dim() const override { return 4; }

@@ -80,8 +80,8 @@ class HenonHeiles final : public tsi::Model, public tsi::HamiltonianStructure, p
   static void fused_field(const tsi::RealVector& cos, const tsi::RealVector& sin, Grid& u, Grid& out) {
     for (Index j = 0; j < u.cols(); ++j) {
       const Real c = cos(j), s = sin(j);
-      const Real q1 = c * std::real(u(0, j)) + s * std::real(u(2, j)), q2 = std::real(u(1, j)),
-                   p2 = std::real(u(3, j));
+      const Real q1 = c * tsi::real_part(u(0, j)) + s * tsi::real_part(u(2, j)), q2 = tsi::real_part(u(1, j)),
+                   p2 = tsi::real_part(u(3, j));
       const Real g = -2.0 * q1 * q2;
       out(0, j) = -s * g;
       out(1, j) = p2;
@@ -103,7 +103,7 @@ class HenonHeiles final : public tsi::Model, public tsi::HamiltonianStructure, p
 
   void apply_M(const Vector& u, Vector& out) const override {
     out.resize(4);
-    out << u(0), 0.0, u(2), 0.0;
+    out << u(0), Complex(0), u(2), Complex(0);
   }
 
   void apply_J(const Vector& u, Vector& out) const override {
@@ -116,7 +116,7 @@ class HenonHeiles final : public tsi::Model, public tsi::HamiltonianStructure, p
     return 0.5 * q2 * q2 + 0.5 * p2 * p2 + q1 * q1 * q2 - q2 * q2 * q2 / 3.0;
   }
 
-  Vector initial_value() const override { return Vector::Constant(4, 0.12); }
+  Vector initial_value() const override { return Vector::Constant(4, Complex(0.12)); }
 };
 
 void register_henon_heiles(tsi::Registry& registry) {

@@ -363,7 +363,7 @@ void register_klein_gordon(tsi::Registry& registry) {
     entry.info.params.push_back(std::move(spec));
   entry.info.params.push_back(
       tsi::number_param("lambda", 1.0, "coefficient of the cubic term lambda z^3")
-          .check([](const tsi::Json& v) { return std::isfinite(v.get<Real>()); }, "a finite number"));
+          .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number"));
   entry.default_n_tau = 32;
   entry.nonlinearity_degree = 3;
   // From h = 1/16: coarser steps are pre-asymptotic for the modes 3, 5, 7 of the default u0

@@ -73,7 +73,7 @@ class PhaseRecurrence {
   }
 
  private:
-  Complex z_, z2_, phase_ = 1.0, factor_;
+  Complex z_, z2_, phase_ = Complex(1), factor_;
 };
 
 // e^{-i m^2 tau_j} for m = 0 .. n/2 (rows) and every tau_j (columns), by the recurrence
@@ -303,7 +303,7 @@ class Nls final : public tsi::Model,
   }
 
   void apply_M(const Vector& u, Vector& out) const override {
-    out = 2.0 * grid_.laplacian_symbol().cwiseProduct(u);
+    out = Real(2) * grid_.laplacian_symbol().cwiseProduct(u);
   }
 
   void apply_J(const Vector& u, Vector& out) const override { out = Complex(0.0, -0.5) * u; }

@@ -267,7 +267,7 @@ void register_vlasov_poisson(tsi::Registry& registry) {
           .check(
               [](const tsi::Json& v) {
                 if (v.is_string()) return !v.get<std::string>().empty();
-                return v.get<Real>() >= 1 && v.get<Real>() <= Real(1L << 28);
+                return v.get<double>() >= 1 && v.get<double>() <= Real(1L << 28);
               },
               "a number of particles from 1 to 2^28, or a file name"),
       tsi::integer_param("n_x", 16, "grid points along x1 (even)")
@@ -312,7 +312,7 @@ void register_vlasov_poisson(tsi::Registry& registry) {
       g.particles = particles.size() / 4;
       tsi::pic::check_positions(particles, g, given.get<std::string>());
     } else {
-      g.particles = static_cast<Index>(given.get<Real>());
+      g.particles = static_cast<Index>(given.get<double>());
       const auto distribution =
           p.string("distribution") == "peer" ? tsi::pic::Distribution::peer : tsi::pic::Distribution::landau;
       particles = tsi::pic::sample_particles(g, distribution, p.number("alpha"), static_cast<std::uint64_t>(p.integer("seed")));

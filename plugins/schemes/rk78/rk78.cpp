@@ -108,8 +108,8 @@ class Rk78 final : public tsi::Stepper {
         two_sum(t_hi, t_lo, dt_taken);
         if (last) break;
       } else if (std::abs(dt) < 1e-14 * std::max(std::abs(t_hi), std::abs(h))) {
-        throw tsi::Error("rk78: step size underflow at t = " + std::to_string(t_hi) + " (tol " +
-                         std::to_string(tol_) + " cannot be met)");
+        throw tsi::Error("rk78: step size underflow at t = " + std::to_string(tsi::to_double(t_hi)) + " (tol " +
+                         std::to_string(tsi::to_double(tol_)) + " cannot be met)");
       }
       dt_ = dt;
     }
