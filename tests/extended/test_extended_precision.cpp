@@ -117,7 +117,7 @@ const Json collocation = {{"name", "collocation"}, {"tol", quad ? 1e-33 : 1e-19}
 
 TEST_CASE("extended precision: eab of orders 3 to 6 on the linear test, uniform in eps, below double's floor") {
   // Measured in double (examples/general/linear-test-extended.json, docs/high-order.md): eab
-  // r = 6 stops at 1e-15 .. 6e-13 from h = 1/128 on (its rounding, amplified); in long double
+  // r = 6 stops at 1e-15 .. 6e-13 from h = 1/128 on (rounding, amplified near resonances); in long double
   // it falls to 1.3e-18 .. 6e-18 at h = 1/512, in quad to 8.1e-19 .. 6.0e-18 there.
   const std::vector<long> steps = {16, 32, 64, 128, 256, 512};
   for (int r = 3; r <= 6; ++r)
