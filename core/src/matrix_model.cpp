@@ -7,13 +7,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <optional>
 #include <set>
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "tsi/affine_exact.hpp"
 #include "tsi/error.hpp"
+#include "tsi/phase.hpp"
 #include "tsi/registry.hpp"
 
 namespace tsi {
@@ -23,8 +23,6 @@ void Field::derivative(const RealVector&, ConstMatrixRef, ConstMatrixRef, Matrix
 }
 
 namespace {
-
-TSI_REAL_CONSTEXPR Real two_pi = 2 * std::numbers::pi_v<Real>;
 
 // A JSON value as a short text for a message (a large matrix is cut).
 std::string shown(const Json& v) {
