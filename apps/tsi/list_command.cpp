@@ -41,6 +41,7 @@ Json list_json(const Registry& registry, const std::string& what) {
     for (const auto* e : registry.models()) {
       Json j = info_json(e->info);
       j["default_n_tau"] = e->default_n_tau;
+      j["linear_remainder"] = e->linear_remainder;
       out["models"].push_back(j);
     }
   }
@@ -58,6 +59,7 @@ Json list_json(const Registry& registry, const std::string& what) {
                      {"symmetric", t.symmetric},
                      {"implicit", t.implicit},   {"multistep", t.multistep},
                      {"adaptive", t.adaptive},   {"initial_data_order", t.initial_data_order},
+                     {"remainder_data_order", t.data_order_for(true)},
                      {"reformulations", t.reformulations}};
       out["schemes"].push_back(j);
     }
@@ -92,7 +94,8 @@ std::string list_text(const Registry& registry, const std::string& what) {
         for (const auto& r : t["reformulations"]) reforms += (reforms.empty() ? "" : ", ") + r.get<std::string>();
         const int classical = t["classical_order"].get<int>();
         const int resonant = t["resonant_order"].get<int>();
-        s += fmt::format("      order {}{}{}, {}, {}, data order {}, on: {}\n", t["order"].get<int>(),
+        const int data = t["initial_data_order"].get<int>(), with_remainder = t["remainder_data_order"].get<int>();
+        s += fmt::format("      order {}{}{}, {}, {}, data order {}{}, on: {}\n", t["order"].get<int>(),
                          classical > t["order"].get<int>() ? fmt::format(" uniformly ({} at fixed eps)", classical) : "",
                          resonant < t["order"].get<int>()
                              ? (resonant > 0 ? fmt::format(", {} at step-size resonances h ~ k pi eps", resonant)
@@ -100,9 +103,12 @@ std::string list_text(const Registry& registry, const std::string& what) {
                              : "",
                          t["symmetric"].get<bool>() ? "symmetric" : "not symmetric",
                          t["implicit"].get<bool>() ? "implicit" : "explicit",
-                         t["initial_data_order"].get<int>(), reforms);
+                         data, with_remainder > data ? fmt::format(" ({} on a model with a remainder)", with_remainder) : "",
+                         reforms);
       }
-      if (e.contains("default_n_tau")) s += fmt::format("      default n_tau {}\n", e["default_n_tau"].get<int>());
+      if (e.contains("default_n_tau"))
+        s += fmt::format("      default n_tau {}{}\n", e["default_n_tau"].get<int>(),
+                         e["linear_remainder"].get<bool>() ? ", a linear remainder R (integrated exactly)" : "");
       if (e.contains("time_dependent"))
         s += fmt::format("      {} entries, {}, {}\n", e["dim"].get<long>() == 0 ? std::string("any number of") : std::to_string(e["dim"].get<long>()),
                          e["time_dependent"].get<bool>() ? "time-dependent" : "autonomous",

@@ -465,12 +465,11 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   const auto& rconf = config["reformulation"];
   const Collective* split = settings.context.collective;  // tsi run --split: this process's share
   if (split) check_split_run(config, assembly, registry);
-  if (rconf.contains("initial_data_order") &&
-      rconf["initial_data_order"].get<int>() < assembly.traits.initial_data_order) {
+  const int data_needed = assembly.traits.data_order_for(assembly.model_entry->linear_remainder);
+  if (rconf.contains("initial_data_order") && rconf["initial_data_order"].get<int>() < data_needed) {
     result["warnings"].push_back(fmt::format(
         "scheme \"{}\" needs prepared data of order {} for uniform accuracy; running with order {}",
-        scheme_entry.info.name, assembly.traits.initial_data_order,
-        rconf["initial_data_order"].get<int>()));
+        scheme_entry.info.name, data_needed, rconf["initial_data_order"].get<int>()));
   }
 
   // f_tau of a nonlinearity of degree d has tau harmonics up to |k| = d + 1 (e^{-i tau} times d

@@ -55,6 +55,10 @@ Vector sample_state(const Model& model, const Vector& u0, Real phase) {
   return w;
 }
 
+/// The eps of a check, sorted down, each once: the given ones and, if `dense`, 32 log-spaced
+/// over their range and the step-size resonances of `steps` inside it.
+std::vector<Real> eps_sample(const std::vector<Real>& epsilons, const std::vector<long>& steps, bool dense);
+
 /// The steps that lie close to a whole number of half fast periods (pi eps), within 0.06 of
 /// one, as "h = 1/16, h = 1/32 are" (empty when none).
 std::string resonant_steps(const std::vector<long>& steps, Real eps, Real max_half_periods = 1e300) {
@@ -170,6 +174,10 @@ class ModelChecks {
     return std::max(floor, it == reference_accuracy_.end() ? 0.0 : 2.0 * it->second);
   }
   std::map<Real, Real> reference_accuracy_;
+  /// The reference at eps in physical variables, computed once (with its accuracy); returns it
+  /// in the model's variables when computed now (empty when it was there already).
+  Vector add_reference(Real eps);
+  std::map<Real, Vector> references_;
   /// The relative errors at T for the given numbers of steps.
   std::vector<Real> errors(const SchemeEntry& scheme, Real eps, const Vector& x_ref,
                              const std::vector<long>& steps, int n_tau_factor = 1, int data_order = 0) const;
@@ -179,7 +187,7 @@ class ModelChecks {
   /// One eps's row (information).
   void orders(const SchemeEntry& scheme, Real eps, const std::vector<Real>& errs);
   /// The verdict: the order of the maximum error over the eps sample.
-  void envelope(const SchemeEntry& scheme, const std::vector<Real>& sample, const std::map<Real, Vector>& references);
+  void envelope(const SchemeEntry& scheme, const std::vector<Real>& sample);
   void symmetry(const SchemeEntry& scheme, Real eps);
 
   const Registry& registry_;
@@ -244,6 +252,14 @@ void ModelChecks::interface(Real eps) {
           "linear_remainder() gives the frequencies of J R in the model's coordinates, and J R must commute "
           "with J M (both diagonal in the model's coordinates)");
   }
+  // The registration's flag sets the prepared data some schemes get (FD: order 4 with R).
+  if (mod.has_linear_remainder())
+    report(entry_.linear_remainder,
+           fmt::format("{:<52} {:>9} {:>9}", "a remainder is declared (ModelEntry::linear_remainder)",
+                       entry_.linear_remainder ? "true" : "false", "true"),
+           "the model has a linear_remainder() but its registration's ModelEntry::linear_remainder is false",
+           "set linear_remainder = true in the model's registration: schemes such as FD choose their prepared "
+           "data's order by it");
 
   // Batched calls: one state per column, each column on its own.
   Matrix states(n, 3), dirs(n, 3);
@@ -405,7 +421,7 @@ std::string ModelChecks::diagnose(const SchemeEntry& scheme, Real eps, const Vec
         "resolve the tau dependence; raise the model's default_n_tau (or reformulation.n_tau)",
         finest.front(), plain, doubled));
   // Prepared data of one order more: U smoother in tau, its modes that h does not resolve smaller.
-  const int data = traits_of(scheme).initial_data_order;
+  const int data = traits_of(scheme).data_order_for(entry_.linear_remainder);
   const int more = std::max(data, options_.reformulation_params.value("initial_data_order", 0)) + 1;
   if (more <= 8) {
     const Real richer = errors(scheme, eps, x_ref, finest, 1, more).front();
@@ -432,8 +448,7 @@ void ModelChecks::orders(const SchemeEntry& scheme, Real eps, const std::vector<
              resonant.empty() ? "" : fmt::format("  ({} pi eps or 2 pi eps)", resonant));
 }
 
-void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& sample,
-                           const std::map<Real, Vector>& references) {
+void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& sample) {
   // Uniform order q: the maximum of the error over eps is at most C h^q. At one eps the error
   // may dip below that bound or rise in a step-size resonance, so the order is judged on the
   // maximum over the dense sample (resonances inside it), fitted above the references' floors.
@@ -448,12 +463,13 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& s
     std::vector<Real> at;  // the eps of each maximum
     Real largest_floor = 0.0;
   };
-  const auto envelope_over = [&](const std::vector<long>& steps) {
+  const auto envelope_over = [&](const std::vector<long>& steps, const std::vector<Real>& epsilons) {
     Envelope env{std::vector<Real>(steps.size(), 0.0), std::vector<Real>(steps.size(), 0.0), 0.0};
-    for (const Real& eps : sample) {
+    for (const Real& eps : epsilons) {
+      add_reference(eps);
       const std::vector<Real> errs =
-          steps == options_.steps ? errors_at(scheme, eps, references.at(eps))
-                                  : errors(scheme, eps, references.at(eps), steps, factor);
+          steps == options_.steps ? errors_at(scheme, eps, references_.at(eps))
+                                  : errors(scheme, eps, references_.at(eps), steps, factor);
       const Real floor = reference_floor(eps, base_floor);
       env.largest_floor = std::max(env.largest_floor, floor);
       for (size_t i = 0; i < steps.size(); ++i) {
@@ -468,7 +484,7 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& s
     }
     return env;
   };
-  const Envelope env = envelope_over(options_.steps);
+  const Envelope env = envelope_over(options_.steps, sample);
   const OrderFit fit = fit_order(doubles(step_sizes(options_.steps)), doubles(env.worst), to_double(base_floor));
   std::string row;
   for (const Real& e : env.worst) row += e > 0.0 ? fmt::format(" {:>9.2e}", e) : fmt::format(" {:>9}", "(ref)");
@@ -506,16 +522,37 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& s
   if (!ok && fit.finite) {
     // The steps may be pre-asymptotic for this model: if the maximum over steps four times
     // finer falls at the order, that fit counts.
-    const Envelope fine = envelope_over(finer_steps_);
+    const Envelope fine = envelope_over(finer_steps_, sample);
     finer = fit_order(doubles(step_sizes(finer_steps_)), doubles(fine.worst), to_double(base_floor));
     ok = finer.finite && finer.measurable && finer.order >= q - margin;
     if (finer.measurable) note = fmt::format("  ({:.2f} over {})", finer.order, step_range(finer_steps_));
+  }
+  OrderFit bound;
+  if (!ok && fit.finite && sample.front() < 1.0) {
+    // Uniform order q is a bound over every eps in (0, 1]. Over a part of that range the
+    // maximum may fall slower and still stay under the bound: while h ~ eps at the top of the
+    // part, the errors there climb from the averaged regime's constant to the resolved one's
+    // (FD on Klein-Gordon, eps <= 1e-2: from 0.03 h^2 to 0.1 h^2, under the 0.3 h^2 reached at
+    // eps ~ 0.1; docs/high-order.md). A miss is judged once more on the maximum over
+    // [eps_min, 1], the bound's own range, sampled as densely.
+    std::vector<Real> wider = eps_sample({sample.front(), Real(1)}, options_.steps, true);
+    wider.insert(wider.end(), sample.begin(), sample.end());
+    wider = eps_sample(wider, {}, false);  // sorted, each eps once
+    for (const std::vector<long>* steps : {&options_.steps, static_cast<const std::vector<long>*>(&finer_steps_)}) {
+      const Envelope w = envelope_over(*steps, wider);
+      bound = fit_order(doubles(step_sizes(*steps)), doubles(w.worst), to_double(base_floor));
+      ok = bound.finite && bound.measurable && bound.used >= 3 && bound.order >= q - margin;
+      if (bound.measurable)
+        note += fmt::format("  ({:.2f} for eps in [{:g}, 1] over {}{})", bound.order, sample.back(), step_range(*steps),
+                            ok ? ": the uniform bound holds, the range given lies below it" : "");
+      if (ok || !bound.finite) break;
+    }
   }
   std::string hint;
   if (!ok) {
     // Diagnose at the eps that set the maximum at the finest step.
     const Real eps = env.at.back() > 0.0 ? env.at.back() : sample.front();
-    hint = diagnose(scheme, eps, references.at(eps));
+    hint = diagnose(scheme, eps, references_.at(eps));
     if (hint.empty())
       hint = fit.finite ? "nothing measured stands out (the field is not stiff at u0 and n_tau resolves tau): the "
                           "two-scale schemes reach their order only on a model of the problem class; see the "
@@ -526,9 +563,7 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& s
   }
   report(ok, fmt::format("{}{} {:>6}  {}{}", name, row, observed, declared, note),
          fmt::format("{}: order of the maximum error over eps {}{}, expected {}", scheme.info.name,
-                     fit.finite ? observed : "- (not finite)",
-                     finer.measurable ? fmt::format(" ({:.2f} over {})", finer.order, step_range(finer_steps_)) : "",
-                     declared),
+                     fit.finite ? observed : "- (not finite)", note, declared),
          hint);
 }
 
@@ -576,26 +611,34 @@ std::vector<Real> eps_sample(const std::vector<Real>& epsilons, const std::vecto
   return unique;
 }
 
+Vector ModelChecks::add_reference(Real eps) {
+  if (references_.count(eps)) return Vector();
+  const auto m = model(eps);
+  const Vector u0 = m->initial_value();
+  const Vector u = reference(m, u0);
+  const Vector& physical = references_[eps] = m->to_physical(u);
+  const Vector coarser = m->to_physical(reference(m, u0, 10.0 * reference_tol));
+  // What the check can resolve at this eps: the reference's own accuracy, and what rounding
+  // the state in model variables once per step does to the physical error over the finest
+  // run's steps (the charged particle at eps = 1e-6: v = (p + B q) / (2 eps) makes one ulp of
+  // p 5e-11 of v, and 512 steps of it reach 1e-9).
+  const Real rounding = m->rounding_floor(u) * static_cast<Real>(options_.steps.back());
+  reference_accuracy_[eps] = std::max<Real>((coarser - physical).norm() / physical.norm(), rounding);
+  return u;
+}
+
 void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
                               const std::vector<Real>& epsilons) {
   const std::vector<Real> sample = eps_sample(epsilons, options_.steps, options_.dense_eps_sample);
-  std::map<Real, Vector> references;
   fmt::print(out_, "\n  reference: rk78 on the filtered problem, tol {:g} (its accuracy: the change from tol {:g}), T = {:g}\n",
              reference_tol, 10.0 * reference_tol, t_end);
   for (const Real& eps : sample) {
+    const Vector u = add_reference(eps);
     const auto m = model(eps);
-    const Vector u0 = m->initial_value();
-    const Vector u = reference(m, u0);
-    references[eps] = m->to_physical(u);
-    const Vector coarser = m->to_physical(reference(m, u0, 10.0 * reference_tol));
-    // What the check can resolve at this eps: the reference's own accuracy, and what rounding
-    // the state in model variables once per step does to the physical error over the finest
-    // run's steps (the charged particle at eps = 1e-6: v = (p + B q) / (2 eps) makes one ulp of
-    // p 5e-11 of v, and 512 steps of it reach 1e-9).
-    const Real rounding = m->rounding_floor(u) * static_cast<Real>(options_.steps.back());
-    reference_accuracy_[eps] = std::max<Real>((coarser - references[eps]).norm() / references[eps].norm(), rounding);
-    if (!m->has_hamiltonian_structure() || std::find(epsilons.begin(), epsilons.end(), eps) == epsilons.end())
+    if (u.size() == 0 || !m->has_hamiltonian_structure() ||
+        std::find(epsilons.begin(), epsilons.end(), eps) == epsilons.end())
       continue;  // no energy to conserve (said in the interface checks), or an eps of the dense sample only
+    const Vector u0 = m->initial_value();
     const Real h0 = m->energy(u0);
     check(fmt::format("energy H conserved at eps = {:g}", eps),
           std::abs(m->energy(u) - h0) / std::max<Real>(std::abs(h0), 1e-300), 1e-6,
@@ -624,8 +667,8 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
   fmt::print(out_, " {:>6}  {}\n", "order", "expected");
   for (const auto* scheme : schemes) {
     try {
-      for (const Real& eps : epsilons) orders(*scheme, eps, errors_at(*scheme, eps, references.at(eps)));
-      envelope(*scheme, sample, references);
+      for (const Real& eps : epsilons) orders(*scheme, eps, errors_at(*scheme, eps, references_.at(eps)));
+      envelope(*scheme, sample);
     } catch (const std::exception& e) {
       report(false, fmt::format("{:<12} {:<10} {}", scheme->info.name, "max", e.what()),
              fmt::format("{}: {}", scheme->info.name, e.what()), "");

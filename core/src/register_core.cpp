@@ -88,7 +88,8 @@ void register_core(Registry& registry) {
       // at least (charged particle, eps = 1, T = 200, auto: err_H 7.9e-3 with order 2, 6.4e-4
       // with order 4).
       const bool reprepared = p.contains("reprepare") && p["reprepare"] != "never";
-      p["initial_data_order"] = std::max({1, traits.initial_data_order, reprepared ? 4 : 1});
+      p["initial_data_order"] =
+          std::max({1, traits.data_order_for(s.model.linear_remainder), reprepared ? 4 : 1});
     }
   };
   two_scale.create = [](std::shared_ptr<const Model> model, const Params& p) {

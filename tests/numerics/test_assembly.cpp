@@ -50,6 +50,11 @@ TEST_CASE("assembly: each entry completes its defaults from the selection") {
   CHECK(fd.sections()["reformulation"]["name"] == "two-scale");
   CHECK(fd.sections()["scheme"]["name"] == "fd");
   CHECK(tsi::resolve_selection(selection("nls", "se1"), registry).reformulation.params["initial_data_order"] == 2);
+  // On a model with a linear remainder FD takes data of order 4 (its traits' remainder_data_order).
+  CHECK(registry.model("klein-gordon").linear_remainder);
+  CHECK_FALSE(registry.model("nls").linear_remainder);
+  CHECK(tsi::resolve_selection(selection("klein-gordon", "fd"), registry).reformulation.params["initial_data_order"] == 4);
+  CHECK(tsi::resolve_selection(selection("klein-gordon", "se1"), registry).reformulation.params["initial_data_order"] == 2);
   // Aliases resolve to canonical names.
   CHECK(tsi::resolve_selection(selection("henon-heiles", "se1-tsi"), registry).scheme.name == "se1");
 }

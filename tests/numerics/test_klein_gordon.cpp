@@ -359,7 +359,7 @@ Vector two_scale_solution(const tsi::SchemeEntry& scheme, double eps, long steps
   auto two_scale = h.reformulation(
       "two-scale", model,
       {{"n_tau", h.registry().model("klein-gordon").default_n_tau},
-       {"initial_data_order", std::max(1, tsi::default_traits(scheme).initial_data_order)}});
+       {"initial_data_order", std::max(1, tsi::default_traits(scheme).data_order_for(true))}});
   auto stepper = h.scheme(scheme.info.name, tight(scheme), "klein-gordon");
   return tsi::test::solve(*model, *two_scale, *stepper, 1.0, steps);
 }

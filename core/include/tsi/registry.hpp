@@ -69,6 +69,11 @@ struct TSI_API ModelEntry {
   /// Degree of J grad H1 as a polynomial in u (Henon-Heiles 2, NLS 3), 0 if not polynomial:
   /// sets the Gauss-Legendre nodes of average-vector-field schemes (quadrature_nodes).
   int nonlinearity_degree = 0;
+  /// The model has a linear remainder R (Model::linear_remainder() not empty, Klein-Gordon),
+  /// for some of its parameters at least: some schemes then need prepared data of a higher
+  /// order (StepperTraits::remainder_data_order). `tsi check` fails a model that has one
+  /// without declaring it.
+  bool linear_remainder = false;
   ModelFactory create;
 };
 

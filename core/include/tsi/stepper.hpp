@@ -35,6 +35,15 @@ struct TSI_API StepperTraits {
   bool needs_diagonal_linear_part = false;  ///< uses Problem::linear_multipliers (exponential schemes)
   bool needs_exact_flows = false;        ///< uses Problem::linear_flow and nonlinear_flow (splitting)
   int initial_data_order = 1;            ///< two-scale prepared data needed for uniform order
+  /// The prepared data needed instead on a model with a linear remainder R (ModelEntry::
+  /// linear_remainder), when more (0: initial_data_order). The data's defect grows with
+  /// eps |R|; a scheme that turns it by a wrong phase (FD's Crank-Nicolson fraction) needs
+  /// it smaller (Klein-Gordon: docs/high-order.md).
+  int remainder_data_order = 0;
+  /// The prepared data this scheme needs on a model with (true) or without a remainder.
+  int data_order_for(bool linear_remainder) const {
+    return linear_remainder ? std::max(initial_data_order, remainder_data_order) : initial_data_order;
+  }
   std::vector<std::string> reformulations;  ///< the reformulations it can integrate
 };
 
