@@ -3,11 +3,13 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <map>
 #include <numbers>
 #include <limits>
+#include <tuple>
 
 #include "tsi/assembly.hpp"
 #include "tsi/convergence.hpp"
@@ -181,9 +183,10 @@ class ModelChecks {
   /// The relative errors at T for the given numbers of steps.
   std::vector<Real> errors(const SchemeEntry& scheme, Real eps, const Vector& x_ref,
                              const std::vector<long>& steps, int n_tau_factor = 1, int data_order = 0) const;
-  /// The errors at eps for the checked steps, computed once per scheme and eps.
-  std::vector<Real> errors_at(const SchemeEntry& scheme, Real eps, const Vector& x_ref);
-  std::map<std::pair<std::string, Real>, std::vector<Real>> errors_;
+  /// The errors at eps for `steps` (the checked ones, or finer), on the scheme's tau grid,
+  /// computed once per scheme, eps and steps.
+  std::vector<Real> errors_at(const SchemeEntry& scheme, Real eps, const std::vector<long>& steps);
+  std::map<std::tuple<std::string, Real, std::vector<long>>, std::vector<Real>> errors_;
   /// One eps's row (information).
   void orders(const SchemeEntry& scheme, Real eps, const std::vector<Real>& errs);
   /// The verdict: the order of the maximum error over the eps sample.
@@ -456,7 +459,6 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& s
   const StepperTraits traits = traits_of(scheme);
   const int q = traits.order_with_resonances();
   const Real margin = q > 2 ? high_order_margin : order_margin;
-  const int factor = tau_factor(traits);
   const Real base_floor = fit_floor(traits);
   struct Envelope {
     std::vector<Real> worst;
@@ -466,10 +468,7 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& s
   const auto envelope_over = [&](const std::vector<long>& steps, const std::vector<Real>& epsilons) {
     Envelope env{std::vector<Real>(steps.size(), 0.0), std::vector<Real>(steps.size(), 0.0), 0.0};
     for (const Real& eps : epsilons) {
-      add_reference(eps);
-      const std::vector<Real> errs =
-          steps == options_.steps ? errors_at(scheme, eps, references_.at(eps))
-                                  : errors(scheme, eps, references_.at(eps), steps, factor);
+      const std::vector<Real> errs = errors_at(scheme, eps, steps);
       const Real floor = reference_floor(eps, base_floor);
       env.largest_floor = std::max(env.largest_floor, floor);
       for (size_t i = 0; i < steps.size(); ++i) {
@@ -543,7 +542,8 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& s
     std::vector<Real> wider = eps_sample({sample.front(), top}, options_.steps, true);
     wider.insert(wider.end(), sample.begin(), sample.end());
     wider = eps_sample(wider, {}, false);  // sorted, each eps once
-    for (const std::vector<long>* steps : {&options_.steps, static_cast<const std::vector<long>*>(&finer_steps_)}) {
+    const std::array<const std::vector<long>*, 2> step_lists = {&options_.steps, &finer_steps_};
+    for (const std::vector<long>* steps : step_lists) {
       const Envelope w = envelope_over(*steps, wider);
       bound = fit_order(doubles(step_sizes(*steps)), doubles(w.worst), to_double(base_floor));
       ok = bound.finite && bound.measurable && bound.used >= 3 && bound.order >= q - margin;
@@ -584,12 +584,13 @@ void ModelChecks::symmetry(const SchemeEntry& scheme, Real eps) {
         "the scheme");
 }
 
-std::vector<Real> ModelChecks::errors_at(const SchemeEntry& scheme, Real eps, const Vector& x_ref) {
-  const auto key = std::make_pair(scheme.info.name, eps);
+std::vector<Real> ModelChecks::errors_at(const SchemeEntry& scheme, Real eps, const std::vector<long>& steps) {
+  auto key = std::make_tuple(scheme.info.name, eps, steps);
   auto it = errors_.find(key);
   if (it == errors_.end()) {
+    add_reference(eps);
     const int factor = tau_factor(traits_of(scheme));
-    it = errors_.emplace(key, errors(scheme, eps, x_ref, options_.steps, factor)).first;
+    it = errors_.emplace(std::move(key), errors(scheme, eps, references_.at(eps), steps, factor)).first;
   }
   return it->second;
 }
@@ -672,7 +673,7 @@ void ModelChecks::convergence(const std::vector<const SchemeEntry*>& schemes,
   fmt::print(out_, " {:>6}  {}\n", "order", "expected");
   for (const auto* scheme : schemes) {
     try {
-      for (const Real& eps : epsilons) orders(*scheme, eps, errors_at(*scheme, eps, references_.at(eps)));
+      for (const Real& eps : epsilons) orders(*scheme, eps, errors_at(*scheme, eps, options_.steps));
       envelope(*scheme, sample);
     } catch (const std::exception& e) {
       report(false, fmt::format("{:<12} {:<10} {}", scheme->info.name, "max", e.what()),
