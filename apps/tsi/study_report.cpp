@@ -205,9 +205,12 @@ Json convergence_summary(const Json& rows) {
       errors.push_back(has_error ? (*m)["error"] : Json());
       failed += has_error ? 0 : 1;
     }
-    Json s = {{"label", (*members[0])["label"]}, {"scheme", (*members[0])["scheme"]},
-              {"model", (*members[0])["model"]}, {"eps", (*members[0])["eps"]},
-              {"varied", (*members[0])["varied"]}, {"h", h}, {"error", errors}};
+    // What makes the series (series_key reads the same fields), then its errors.
+    Json s = {{"label", (*members[0])["label"]},   {"scheme", (*members[0])["scheme"]},
+              {"model", (*members[0])["model"]},   {"reformulation", (*members[0])["reformulation"]},
+              {"t_end", (*members[0])["t_end"]},   {"n_tau", (*members[0])["n_tau"]},
+              {"eps", (*members[0])["eps"]},       {"varied", (*members[0])["varied"]},
+              {"h", h},                            {"error", errors}};
     Json successive = Json::array();
     for (size_t k = 0; k + 1 < e.size(); ++k)
       successive.push_back(e[k] > 0 && e[k + 1] > 0 ? Json(std::log(e[k] / e[k + 1]) / std::log(h[k] / h[k + 1]))
@@ -406,7 +409,9 @@ std::string study_text(const Study& study, const Json& rows) {
     const Json summary = convergence_summary(rows);
     std::map<std::string, std::vector<const Json*>> groups;  // one table per series without eps
     std::vector<std::string> order;
+    std::set<std::string> n_taus;  // several: each table says its own
     for (const auto& row : rows) {
+      n_taus.insert(row["n_tau"].dump());
       const std::string key = series_key(row, true);
       if (!groups.count(key)) order.push_back(key);
       groups[key].push_back(&row);
@@ -423,6 +428,7 @@ std::string study_text(const Study& study, const Json& rows) {
       std::string name = first["label"].get<std::string>().empty() ? first["scheme"].get<std::string>()
                                                                    : first["label"].get<std::string>();
       if (!first["varied"].empty()) name = fmt::format("{} {}", name, first["varied"].dump());
+      if (n_taus.size() > 1) name = fmt::format("{} (n_tau {})", name, first["n_tau"].dump());
       s += fmt::format("\n{} on {}: relative error at t = {:g} (observed order)\n", name,
                        first["model"].get<std::string>(), first["t_end"].get<double>());
       s += fmt::format("  {:>8}", "h");
@@ -448,8 +454,7 @@ std::string study_text(const Study& study, const Json& rows) {
       for (double e : epss) {
         std::string c = "-";
         for (const auto& series : summary["series"])
-          if (series["eps"] == e && series["scheme"] == first["scheme"] && series["label"] == first["label"] &&
-              series["varied"] == first["varied"] && series["model"] == first["model"]) {
+          if (series["eps"] == e && series_key(series, true) == key) {
             if (series["least_squares_order"].is_number())
               c = fmt::format("{:.2f}", series["least_squares_order"].get<double>());
             else if (series.contains("failed_runs"))  // never fitted across a failure

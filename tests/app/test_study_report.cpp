@@ -49,6 +49,32 @@ TEST_CASE("the convergence summary groups series by eps and takes the max over e
   CHECK(summary["uniform"][0]["max_error_over_eps"][0].get<double>() == doctest::Approx(0.5));  // 2 * 0.5^2
 }
 
+TEST_CASE("each table of a study that varies n_tau gives its own least-squares order") {
+  // n_tau has a column of its own, so it is not among the varied paths: the tables are told
+  // apart by it, and so must their LS rows be (the coarse grid's flat errors fit at 0, not at
+  // the fine grid's 2).
+  tsi::Json rows = tsi::Json::array();
+  int k = 0;
+  for (int n_tau : {16, 64})
+    for (double h : {0.5, 0.25, 0.125}) {
+      tsi::Json r = row(fmt::format("r{}", ++k), 1.0, h, n_tau == 16 ? 1e-4 : h * h);
+      r["n_tau"] = n_tau;
+      rows.push_back(r);
+    }
+  tsi::app::Study study;
+  study.kind = "convergence";
+  const std::string text = tsi::app::study_text(study, rows);
+  INFO(text);
+  const size_t coarse = text.find("s (n_tau 16) on m"), fine = text.find("s (n_tau 64) on m");
+  REQUIRE(coarse != std::string::npos);
+  REQUIRE(fine != std::string::npos);
+  REQUIRE(coarse < fine);
+  const size_t coarse_fit = text.find("LS order", coarse), fine_fit = text.find("LS order", fine);
+  REQUIRE(coarse_fit < fine);
+  CHECK(text.substr(coarse_fit, text.find('\n', coarse_fit) - coarse_fit).find("0.00") != std::string::npos);
+  CHECK(text.substr(fine_fit, text.find('\n', fine_fit) - fine_fit).find("2.00") != std::string::npos);
+}
+
 TEST_CASE("the convergence summary never fits an order across a failed run") {
   tsi::Json rows = tsi::Json::array();
   int k = 0;
