@@ -9,8 +9,8 @@
 namespace tsi {
 
 /// The real type of states, times, step sizes and scheme coefficients: double, or long double
-/// in a build configured with TSI_PRECISION=long-double (precision.hpp). Counters, timings
-/// and memory figures stay double in every build.
+/// or quad (Boost's float128) in a build configured with TSI_PRECISION=long-double or quad
+/// (precision.hpp). Counters, timings and memory figures stay double in every build.
 using Real = TSI_REAL_TYPE;
 using Complex = std::complex<Real>;
 /// A state: complex throughout (real models keep zero imaginary parts).
