@@ -312,20 +312,30 @@ Vector TauGrid::evaluate(ConstMatrixRef c, Real tau) const {
 #endif
   for (Index b = 0; b < blocks; ++b) {
     const Index r0 = b * block, rn = std::min(block, dim_ - r0);
+    if (real) {  // the real parts only, mode by mode (the imaginary parts stay 0)
+      Real* v = reinterpret_cast<Real*>(value.data() + r0);
+      for (int j = 0; j < c.cols(); ++j) {
+        const Real* x = reinterpret_cast<const Real*>(c.col(j).data() + r0);
+        const Complex f = factors[static_cast<std::size_t>(j)];
+        if (j == 0) {
+          for (Index r = 0; r < rn; ++r) v[2 * r] = x[2 * r];
+        } else if (2 * j == n_tau_) {  // stored with the half of both signs: its real part
+          for (Index r = 0; r < rn; ++r) v[2 * r] += f.real() * x[2 * r];
+        } else {  // 2 Re(c_k e^{i k tau})
+          const Real re = 2.0 * f.real(), im = 2.0 * f.imag();
+          for (Index r = 0; r < rn; ++r) v[2 * r] += re * x[2 * r] - im * x[2 * r + 1];
+        }
+      }
+      continue;
+    }
     auto v = value.segment(r0, rn);
     for (int j = 0; j < c.cols(); ++j) {
       const Complex f = factors[static_cast<std::size_t>(j)];
       const auto col = c.col(j).segment(r0, rn);
-      if (!real && 2 * j == n_tau_)
+      if (2 * j == n_tau_)
         v += col * f.real();
-      else if (!real)
-        v += col * f;
-      else if (j == 0)
-        v += col.real().cast<Complex>();
-      else if (2 * j == n_tau_)
-        v += col.real().cast<Complex>() * f.real();
       else
-        v += (2.0 * (col * f).real()).cast<Complex>();
+        v += col * f;
     }
   }
   return value;

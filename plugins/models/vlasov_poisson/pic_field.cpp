@@ -1,7 +1,10 @@
 #include "pic_field.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <string>
 
+#include "tsi/error.hpp"
 #include "tsi/phase.hpp"
 
 namespace tsi::pic {
@@ -12,103 +15,155 @@ Real fifth(Real z) {
   return z2 * z2 * z;
 }
 
-// The weights of the nodes first .. first + W - 1 of a particle at fraction d in [0, 1) of its
-// cell: M6 (the quintic B-spline, as the peer writes it, at distances 2 + d, 1 + d, d, 1 - d,
-// 2 - d, 3 - d) or CIC. Branch-free: the same arithmetic for every particle.
+// The particle loops are built for the baseline x86-64 and again for AVX2 + FMA (x86-64-v3) and
+// AVX-512 (v4); the loader runs the one this CPU has (GCC's function multiversioning). The
+// particles' weights then go four or eight to a register. Other compilers build the baseline.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define TSI_PARTICLE_KERNEL __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
+#else
+#define TSI_PARTICLE_KERNEL
+#endif
+
+// Particles go by blocks: first the cells and weights of the whole block, stored weight by
+// weight over its particles (the same arithmetic for every particle, so SIMD lanes take
+// particles), then each particle's stencil sum.
+constexpr int block = 64;
+
 template <int W>
-void weights(Real d, Real* w) {
+struct Stencils {
+  Real x1[block], x2[block];   // the block's positions, contiguous
+  std::int32_t origin[block];  // the padded index of each particle's first node (Field checks the range)
+  Real wx[W][block], wy[W][block];
+};
+
+// The weights of the nodes first .. first + W - 1 of particle t at fraction d in [0, 1) of its
+// cell: M6 (the quintic B-spline, as the peer writes it, at distances 2 + d, 1 + d, d, 1 - d,
+// 2 - d, 3 - d) or CIC.
+template <int W>
+[[gnu::always_inline]] inline void weights(Real d, Real (&w)[W][block], int t) {
   if constexpr (W == 2) {
-    w[0] = 1.0 - d;
-    w[1] = d;
+    w[0][t] = 1.0 - d;
+    w[1][t] = d;
   } else {
     static_assert(W == 6);
     constexpr Real c = 1.0 / 120.0;
     const Real a = 1.0 - d;
     const Real a5 = fifth(a), d5 = fifth(d), a1 = fifth(1.0 + a), d1 = fifth(1.0 + d);
-    w[0] = a5 * c;
-    w[1] = (a1 - 6.0 * a5) * c;
-    w[2] = (fifth(2.0 + a) - 6.0 * a1 + 15.0 * a5) * c;
-    w[3] = (fifth(2.0 + d) - 6.0 * d1 + 15.0 * d5) * c;
-    w[4] = (d1 - 6.0 * d5) * c;
-    w[5] = d5 * c;
+    w[0][t] = a5 * c;
+    w[1][t] = (a1 - 6.0 * a5) * c;
+    w[2][t] = (fifth(2.0 + a) - 6.0 * a1 + 15.0 * a5) * c;
+    w[3][t] = (fifth(2.0 + d) - 6.0 * d1 + 15.0 * d5) * c;
+    w[4][t] = (d1 - 6.0 * d5) * c;
+    w[5][t] = d5 * c;
   }
 }
 
-// The cell of coordinate x (x / h = cell + d, d in [0, 1)), wrapped into 0 .. n - 1. A
-// coordinate that is not finite gets cell 0 and d NaN: its weights, and so E, are NaN too.
-int cell(Real x, Real inverse_h, int n, Real& d) {
-  const Real p = x * inverse_h;
-  Real i = std::floor(p);
-  d = p - i;
-  if (!(i >= 0.0 && i < n)) {
-    i -= n * std::floor(i / n);
-    if (i >= n) i -= n;
-    if (i < 0.0) i += n;
-    if (!(i >= 0.0 && i < n)) i = 0.0;
-  }
-  return static_cast<int>(i);
+// floor(x / h) wrapped into 0 .. n - 1, without branches. A coordinate that is not finite gets
+// cell 0 and a fraction d that is NaN: its weights, and so E, are NaN too.
+[[gnu::always_inline]] inline Real wrapped_cell(Real i, Real n) {
+  const Real w = i - n * std::floor(i / n);  // exact: i and n are integers
+  return w >= 0.0 && w < n ? w : Real(0);
 }
 
-struct Located {
-  Index origin;  // the padded index of the stencil's first node
-  Real wx[6], wy[6];
+struct Grid {
+  Real inverse_dx, inverse_dy;
+  Real n_x, n_y, padded_x;
 };
 
+// The block's positions are copied out of the state first (strided there) so that the cells
+// and weights are one loop over contiguous arrays; the part of a last block past the particles
+// is zero, and never read.
 template <int W>
-Located locate(Real x1, Real x2, Real inverse_dx, Real inverse_dy, int n_x, int n_y, Index padded_x) {
-  Located l;
-  Real d1 = 0.0, d2 = 0.0;
-  const int i = cell(x1, inverse_dx, n_x, d1), j = cell(x2, inverse_dy, n_y, d2);
-  weights<W>(d1, l.wx);
-  weights<W>(d2, l.wy);
-  l.origin = static_cast<Index>(j) * padded_x + i;
-  return l;
+[[gnu::always_inline]] inline void locate_block(const Real* base, ParticleLayout layout, Index k0, int m,
+                                                const Grid& g, Stencils<W>& s) {
+  const Index ps = layout.particle_stride, cs = layout.component_stride;
+  for (int t = 0; t < m; ++t) {
+    const Real* p = base + (k0 + t) * ps;
+    s.x1[t] = p[0];
+    s.x2[t] = p[cs];
+  }
+  for (int t = m; t < block; ++t) s.x1[t] = s.x2[t] = 0.0;
+  for (int t = 0; t < block; ++t) {
+    const Real p1 = s.x1[t] * g.inverse_dx, p2 = s.x2[t] * g.inverse_dy;
+    const Real f1 = std::floor(p1), f2 = std::floor(p2);
+    const Real i = wrapped_cell(f1, g.n_x), j = wrapped_cell(f2, g.n_y);
+    s.origin[t] = static_cast<std::int32_t>(j * g.padded_x + i);  // exact: integers below 2^31
+    weights<W>(p1 - f1, s.wx, t);
+    weights<W>(p2 - f2, s.wy, t);
+  }
 }
 
 template <int W>
-void deposit_all(const Real* base, ParticleLayout layout, Index particles, Real w, Real inverse_dx,
-                 Real inverse_dy, int n_x, int n_y, Index padded_x, Real* rho) {
-  const Index ps = layout.particle_stride, cs = layout.component_stride;
-  for (Index k = 0; k < particles; ++k) {
-    const Real* p = base + k * ps;
-    const Located l = locate<W>(p[0], p[cs], inverse_dx, inverse_dy, n_x, n_y, padded_x);
-    for (int b = 0; b < W; ++b) {
-      Real* row = rho + l.origin + b * padded_x;
-      const Real s = w * l.wy[b];
-      for (int a = 0; a < W; ++a) row[a] += s * l.wx[a];
+[[gnu::always_inline]] inline void deposit_all(const Real* base, ParticleLayout layout, Index particles, Real w,
+                                               const Grid& g, Real* rho) {
+  Stencils<W> s;
+  const Index padded_x = static_cast<Index>(g.padded_x);
+  for (Index k0 = 0; k0 < particles; k0 += block) {
+    const int m = static_cast<int>(std::min<Index>(block, particles - k0));
+    locate_block<W>(base, layout, k0, m, g, s);
+    for (int t = 0; t < m; ++t)
+      for (int b = 0; b < W; ++b) {
+        Real* row = rho + s.origin[t] + b * padded_x;
+        const Real wy = w * s.wy[b][t];
+        for (int a = 0; a < W; ++a) row[a] += wy * s.wx[a][t];
+      }
+  }
+}
+
+// E at the particles from the padded field stored as (E1, E2) pairs: the rows of a stencil are
+// 2 W contiguous values, summed with the y weights first (one multiply-add per value, over
+// pairs: they stay in vector registers), then with the x weights.
+template <int W>
+[[gnu::always_inline]] inline void interpolate_all(const Real* base, ParticleLayout layout, Index particles,
+                                                   const Grid& g, const Real* e, Real* out) {
+  Stencils<W> s;
+  const Index padded_x = static_cast<Index>(g.padded_x);
+  for (Index k0 = 0; k0 < particles; k0 += block) {
+    const int m = static_cast<int>(std::min<Index>(block, particles - k0));
+    locate_block<W>(base, layout, k0, m, g, s);
+    for (int t = 0; t < m; ++t) {
+      Real acc[2 * W] = {};
+      for (int b = 0; b < W; ++b) {
+        const Real* row = e + 2 * (s.origin[t] + b * padded_x);
+        const Real wy = s.wy[b][t];
+        for (int a = 0; a < 2 * W; ++a) acc[a] += wy * row[a];
+      }
+      Real sum[2] = {0.0, 0.0};
+      for (int a = 0; a < W; ++a) {
+        sum[0] += s.wx[a][t] * acc[2 * a];
+        sum[1] += s.wx[a][t] * acc[2 * a + 1];
+      }
+      out[2 * (k0 + t)] = sum[0];
+      out[2 * (k0 + t) + 1] = sum[1];
     }
   }
 }
 
-// E at one particle from the padded field stored as (E1, E2) pairs: the rows of its stencil are
-// 2 W contiguous values, summed with the y weights first (one multiply-add per value, over
-// pairs: the compiler keeps them in vector registers), then with the x weights.
-template <int W>
-void interpolate(const Located& l, const Real* e, Index padded_x, Real& out1, Real& out2) {
-  Real acc[2 * W] = {};
-  for (int b = 0; b < W; ++b) {
-    const Real* row = e + 2 * (l.origin + b * padded_x);
-    const Real wy = l.wy[b];
-    for (int a = 0; a < 2 * W; ++a) acc[a] += wy * row[a];
-  }
-  Real sum[2] = {0.0, 0.0};
-  for (int a = 0; a < W; ++a) {
-    sum[0] += l.wx[a] * acc[2 * a];
-    sum[1] += l.wx[a] * acc[2 * a + 1];
-  }
-  out1 = sum[0];
-  out2 = sum[1];
+TSI_PARTICLE_KERNEL void deposit_m6(const Real* base, ParticleLayout layout, Index particles, Real w, const Grid& g,
+                                    Real* rho) {
+  deposit_all<6>(base, layout, particles, w, g, rho);
+}
+TSI_PARTICLE_KERNEL void deposit_cic(const Real* base, ParticleLayout layout, Index particles, Real w, const Grid& g,
+                                     Real* rho) {
+  deposit_all<2>(base, layout, particles, w, g, rho);
+}
+TSI_PARTICLE_KERNEL void interpolate_m6(const Real* base, ParticleLayout layout, Index particles, const Grid& g,
+                                        const Real* e, Real* out) {
+  interpolate_all<6>(base, layout, particles, g, e, out);
+}
+TSI_PARTICLE_KERNEL void interpolate_cic(const Real* base, ParticleLayout layout, Index particles, const Grid& g,
+                                         const Real* e, Real* out) {
+  interpolate_all<2>(base, layout, particles, g, e, out);
 }
 
-template <int W>
-void interpolate_all(const Real* base, ParticleLayout layout, Index particles, Real inverse_dx, Real inverse_dy,
-                     int n_x, int n_y, Index padded_x, const Real* e, Real* out) {
-  const Index ps = layout.particle_stride, cs = layout.component_stride;
-  for (Index k = 0; k < particles; ++k) {
-    const Real* p = base + k * ps;
-    const Located l = locate<W>(p[0], p[cs], inverse_dx, inverse_dy, n_x, n_y, padded_x);
-    interpolate<W>(l, e, padded_x, out[2 * k], out[2 * k + 1]);
-  }
+// n + width - 1 points along one direction. The particle loops index the padded grid with 32
+// bits: n is at most 2^14 per direction (the model's own limit), so that the grid stays below 2^31.
+Index padded_points(int n, int width, const char* name) {
+  constexpr int largest = 1 << 14;
+  if (n < 2 || n > largest)
+    throw Error(std::string("vlasov-poisson-2d: ") + name + " = " + std::to_string(n) + ", expected an integer from 2 to " +
+                std::to_string(largest));
+  return static_cast<Index>(n) + width - 1;
 }
 
 }  // namespace
@@ -121,8 +176,8 @@ Field::Field(const Geometry& geometry, const Collective* collective)
       collective_(collective),
       width_(geometry.shape == Shape::cic ? 2 : 6),
       offset_(geometry.shape == Shape::cic ? 0 : 2),
-      padded_x_(geometry.n_x + width_ - 1),
-      padded_y_(geometry.n_y + width_ - 1),
+      padded_x_(padded_points(geometry.n_x, width_, "n_x")),
+      padded_y_(padded_points(geometry.n_y, width_, "n_y")),
       inverse_dx_(1.0 / geometry.dx()),
       inverse_dy_(1.0 / geometry.dy()),
       grid_({geometry.n_y, geometry.n_x}),
@@ -147,12 +202,8 @@ Field::~Field() = default;
 
 void Field::deposit(const Real* base, ParticleLayout layout) {
   padded_rho_.setZero();
-  if (width_ == 2)
-    deposit_all<2>(base, layout, g_.particles, g_.weight(), inverse_dx_, inverse_dy_, g_.n_x, g_.n_y, padded_x_,
-                   padded_rho_.data());
-  else
-    deposit_all<6>(base, layout, g_.particles, g_.weight(), inverse_dx_, inverse_dy_, g_.n_x, g_.n_y, padded_x_,
-                   padded_rho_.data());
+  const Grid grid{inverse_dx_, inverse_dy_, Real(g_.n_x), Real(g_.n_y), Real(padded_x_)};
+  (width_ == 2 ? deposit_cic : deposit_m6)(base, layout, g_.particles, g_.weight(), grid, padded_rho_.data());
   // Fold the padding onto the periodic grid: padded (J, I) is node (J - offset, I - offset) mod n.
   auto values = transforms_->values();
   Real* rho = values.col(0).data();
@@ -228,12 +279,8 @@ bool Field::same_positions(const Real* base, ParticleLayout layout) const {
 const Real* Field::interpolate(const Real* base, ParticleLayout layout) {
   pad_field();
   e_at_.resize(2 * g_.particles);
-  if (width_ == 2)
-    interpolate_all<2>(base, layout, g_.particles, inverse_dx_, inverse_dy_, g_.n_x, g_.n_y, padded_x_,
-                       padded_e_.data(), e_at_.data());
-  else
-    interpolate_all<6>(base, layout, g_.particles, inverse_dx_, inverse_dy_, g_.n_x, g_.n_y, padded_x_,
-                       padded_e_.data(), e_at_.data());
+  const Grid grid{inverse_dx_, inverse_dy_, Real(g_.n_x), Real(g_.n_y), Real(padded_x_)};
+  (width_ == 2 ? interpolate_cic : interpolate_m6)(base, layout, g_.particles, grid, padded_e_.data(), e_at_.data());
   e_at_solved_ = false;  // E at other positions than the field's own (the diagonal field)
   return e_at_.data();
 }
