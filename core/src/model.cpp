@@ -48,6 +48,10 @@ void TauGridField::evaluate_real(RealMatrixRef, RealMatrixRef) {
   throw Error("this tau-grid binding does not evaluate real grids (evaluates_real() is false)");
 }
 
+void TauGridField::evaluate_rows_real(RealMatrixRef, Index) const {
+  throw Error("this tau-grid binding does not evaluate blocks of rows (independent_row_group() is 0)");
+}
+
 void FusedTauGrid::filtered_field(const RealVector& taus, MatrixRef states, MatrixRef out) const {
   bind_tau_grid(taus)->evaluate(states, out);
 }

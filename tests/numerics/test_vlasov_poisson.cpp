@@ -287,3 +287,29 @@ TEST_CASE("vlasov-poisson-2d: etd2rk reproduces the UA-PIC peer's first step and
   // which prepares each step from its own state, differs from it by that alone.
   CHECK(largest_difference(8, "n2048_step8_peer.bin") > 1e-4);
 }
+
+TEST_CASE("vlasov-poisson-2d: the diagonal field by blocks of particles is the whole grid's, on any number of threads") {
+  // Frozen along tau, the diagonal's field makes each particle's f its own: the real tau grid
+  // then goes 64 particles at a time (TauGridField::evaluate_rows_real), the complex one
+  // (real_layout false) through the whole grid. 1000 particles: a last block of 40.
+  auto& h = Harness::instance();
+  const auto run = [&](bool real_layout) {
+    tsi::Assembly a = h.assemble(
+        {{"model",
+          {{"name", "vlasov-poisson-2d"}, {"eps", 0.1}, {"n_x", 32}, {"n_y", 16}, {"particles", 1000},
+           {"distribution", "peer"}, {"alpha", 0.5}, {"tau_field", "diagonal"}}},
+         {"reformulation", {{"name", "two-scale"}, {"n_tau", 16}, {"real_layout", real_layout}}},
+         {"scheme", {{"name", "etd2rk"}}}});
+    Vector y = a.reformulation->prepare(a.u0);
+    tsi::integrate(a.bind(0.1), y, 3, [](long, double, const Vector&) { return true; },
+                   a.reformulation->repreparation());
+    return Vector(a.reformulation->read_back(y, 0.3));
+  };
+  const Vector whole_grid = run(false);
+  const Vector blocks = run(true);
+  CHECK((blocks - whole_grid).norm() / whole_grid.norm() < 1e-13);
+  CHECK((blocks - whole_grid).norm() > 0.0);  // two routes: rounding apart, not the same code
+  tsi::test::ContextSetting two_threads(tsi::test::ContextSetting::tau_grid(2, 1));
+  const Vector threaded = run(true);
+  CHECK((threaded - blocks).cwiseAbs().maxCoeff() == 0.0);  // each block alike on any thread
+}

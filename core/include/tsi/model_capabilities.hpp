@@ -43,6 +43,20 @@ class TSI_API TauGridField {
   /// The diagonal value (dim entries) for the evaluation that follows; it stays valid until
   /// that evaluation returns.
   virtual void set_diagonal(const Vector& /*diagonal*/) {}
+
+  /// Rows per group of a field that, once its diagonal is set, is independent across groups of
+  /// rows (each particle's f depends on its own coordinates and the frozen field only); 0, the
+  /// default, when it is not. The two-scale problem of a real model then transforms and
+  /// evaluates its tau grid a block of rows at a time, in cache (evaluate_rows_real), instead of
+  /// streaming the whole grid through memory between the transforms and the field.
+  virtual Index independent_row_group() const { return 0; }
+  /// Readies the field of the diagonal set last for evaluate_rows_real: called on one thread,
+  /// before the blocks.
+  virtual void prepare_rows() {}
+  /// f in place on a block of real grid values (values.rows() rows, whole groups, all columns;
+  /// row 0 is row first_row of the grid). Called from several threads at once on disjoint
+  /// blocks after prepare_rows, hence const. The default throws.
+  virtual void evaluate_rows_real(RealMatrixRef values, Index first_row) const;
 };
 
 /// The filtered field f_tau(u) = e^{-A tau} f(e^{A tau} u) in one pass instead of the three

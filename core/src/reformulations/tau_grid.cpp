@@ -65,7 +65,6 @@ TauGrid::TauGrid(std::shared_ptr<const Model> model, int n_tau, bool real_layout
   const int rows = static_cast<int>(dim_);
   if (real_layout_) {
     real_fft_ = std::make_unique<RealFftBatch>(n_tau, rows, threads_);
-    grid_values_.setZero(dim_, n_tau);
   } else {
     fft_ = std::make_unique<FftBatch>(n_tau, rows, threads_, context.fft);
   }
@@ -76,6 +75,16 @@ TauGrid::TauGrid(std::shared_ptr<const Model> model, int n_tau, bool real_layout
     column_fields_.push_back(model_->bind_tau_grid(taus_.segment(column_begin_[p], column_begin_[p + 1] - column_begin_[p])));
   if (real_layout_) {
     real_kernels_ = grid_field_->evaluates_real();
+    // A field independent across groups of rows goes by blocks of them: 64 groups (a block of
+    // 64 particles x 16 tau points is 32 kB of values), no grid of the state's size.
+    if (const Index group = grid_field_->independent_row_group(); real_kernels_ && group > 0) {
+      if (dim_ % group != 0)
+        throw Error("tau grid: the model's independent row groups (" + std::to_string(group) +
+                    " rows) do not divide its dimension " + std::to_string(dim_));
+      row_blocks_ = std::make_unique<RealFftRows>(n_tau, dim_, 64 * group);
+      return;
+    }
+    grid_values_.setZero(dim_, n_tau);
     for (const auto& f : column_fields_) real_kernels_ = real_kernels_ && f->evaluates_real();
     bool in_place = real_kernels_ && grid_field_->in_place();
     for (const auto& f : column_fields_) in_place = in_place && f->in_place();
@@ -169,7 +178,44 @@ void TauGrid::on_grid_threads(In&& transform_in, Field&& evaluate, Out&& transfo
     if (error) std::rethrow_exception(error);
 }
 
+void TauGrid::nonlinear_by_rows(const Vector& y, const Vector* mean_shift, Vector& out) {
+  out.resize(size());
+  grid_field_->prepare_rows();
+  const TauGridField& field = *grid_field_;
+  const RealFftRows& blocks = *row_blocks_;
+  const Real scale = 1.0 / n_tau_;  // the 1/n of the transform
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads_));
+  // Each block is computed the same way on any number of threads: the same numbers.
+#if defined(_OPENMP)
+#pragma omp parallel num_threads(threads_) if (threads_ > 1)
+#endif
+  {
+    RealMatrix buffer(blocks.block_rows(), n_tau_);
+#if defined(_OPENMP)
+#pragma omp for schedule(static)
+#endif
+    for (Index b = 0; b < blocks.blocks(); ++b) {
+      auto& error = errors[static_cast<std::size_t>(thread_index())];
+      if (error) continue;  // this thread failed: the others finish, the caller gets the error
+      try {
+        const Index r0 = blocks.block_begin(b), rn = blocks.rows_of(b);
+        Eigen::Map<RealMatrix> values(buffer.data(), rn, n_tau_);
+        blocks.backward(y.data(), b, values.data());
+        if (mean_shift) values.colwise() += mean_shift->segment(r0, rn).real();
+        field.evaluate_rows_real(values, r0);
+        blocks.forward_unnormalised(values.data(), b, out.data());
+        for (int j = 0; j < columns_; ++j) out.segment(j * dim_ + r0, rn) *= scale;
+      } catch (...) {
+        error = std::current_exception();
+      }
+    }
+  }
+  for (const auto& error : errors)
+    if (error) std::rethrow_exception(error);
+}
+
 void TauGrid::nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& out) {
+  if (row_blocks_) return nonlinear_by_rows(y, mean_shift, out);
   out.resize(size());
   const bool in_place = field_values_.size() == 0;
   const Real* field = in_place ? grid_values_.data() : field_values_.data();

@@ -6,6 +6,7 @@
 #include "tsi/fft.hpp"
 #include "tsi/model.hpp"
 #include "tsi/real_fft.hpp"
+#include "../real_fft_rows.hpp"
 
 namespace tsi {
 
@@ -77,6 +78,9 @@ class TauGrid {
   void evaluate_real_grid(TauGridField& field, Index c0, Index cn);
   /// nonlinear in the real layout.
   void nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& out);
+  /// nonlinear in the real layout by blocks of rows (row_blocks_): a block's coefficients to
+  /// its values, f, and back, in a buffer per thread; the blocks split over threads_.
+  void nonlinear_by_rows(const Vector& y, const Vector* mean_shift, Vector& out);
   /// nonlinear on the tau grid split over threads_: each thread transforms its rows and
   /// evaluates the field on its columns (between barriers); the same numbers as the serial path.
   void nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out);
@@ -112,6 +116,9 @@ class TauGrid {
   RealMatrix field_values_;  // f_tau(U) where it does not
   bool real_kernels_ = false;  // the bindings evaluate real grids; otherwise through complex copies:
   Matrix complex_grid_, complex_field_;
+  // Real layout, a field independent across groups of rows: transforms and field by blocks of
+  // rows, each in a small buffer (none of the grid's size).
+  std::unique_ptr<RealFftRows> row_blocks_;
 };
 
 }  // namespace tsi

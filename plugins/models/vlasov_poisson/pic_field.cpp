@@ -279,10 +279,14 @@ bool Field::same_positions(const Real* base, ParticleLayout layout) const {
 const Real* Field::interpolate(const Real* base, ParticleLayout layout) {
   pad_field();
   e_at_.resize(2 * g_.particles);
-  const Grid grid{inverse_dx_, inverse_dy_, Real(g_.n_x), Real(g_.n_y), Real(padded_x_)};
-  (width_ == 2 ? interpolate_cic : interpolate_m6)(base, layout, g_.particles, grid, padded_e_.data(), e_at_.data());
+  interpolate_into(base, layout, g_.particles, e_at_.data());
   e_at_solved_ = false;  // E at other positions than the field's own (the diagonal field)
   return e_at_.data();
+}
+
+void Field::interpolate_into(const Real* base, ParticleLayout layout, Index count, Real* out) const {
+  const Grid grid{inverse_dx_, inverse_dy_, Real(g_.n_x), Real(g_.n_y), Real(padded_x_)};
+  (width_ == 2 ? interpolate_cic : interpolate_m6)(base, layout, count, grid, padded_e_.data(), out);
 }
 
 const Real* Field::at_particles(const Real* base, ParticleLayout layout) {

@@ -64,6 +64,11 @@ class Field {
   const Real* at_particles(const Real* base, ParticleLayout layout);
   /// E of the last solve at each of the N particles at `base` (as at_particles' values).
   const Real* interpolate(const Real* base, ParticleLayout layout);
+  /// Readies the last solve's field for interpolate_into (one thread, before them).
+  void prepare_interpolation() { pad_field(); }
+  /// E of the last solve at the `count` particles at `base`, (E1, E2) of particle k at out[2k],
+  /// out[2k + 1], after prepare_interpolation. Const: threads may call it at once.
+  void interpolate_into(const Real* base, ParticleLayout layout, Index count, Real* out) const;
   /// (1/2) int |E|^2 over the box (the grid's rectangle rule) of the last solve.
   Real field_energy() const;
   /// int rho over the box before the mean was taken off (N w = |box| when nothing is lost).

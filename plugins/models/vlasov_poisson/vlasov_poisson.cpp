@@ -128,16 +128,37 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
       diagonal_ = &diagonal;
       diagonal_solved_ = false;
     }
+    // The diagonal's field is frozen along tau: each particle's f is then its own, 4 rows.
+    Index independent_row_group() const override { return tau_field_ == TauField::diagonal ? 4 : 0; }
+    void prepare_rows() override {
+      solve_diagonal();
+      field_.prepare_interpolation();
+    }
+    void evaluate_rows_real(tsi::RealMatrixRef values, Index) const override {
+      constexpr Index chunk = 64;  // particles per interpolation: E for them on the stack
+      Real e[2 * chunk];
+      const Index particles = values.rows() / 4;
+      for (Index j = 0; j < values.cols(); ++j)
+        for (Index k0 = 0; k0 < particles; k0 += chunk) {
+          const Index m = std::min(chunk, particles - k0);
+          Real* u = values.col(j).data() + 4 * k0;
+          field_.interpolate_into(u, real_layout, m, e);
+          filtered_column(e, m, u, real_layout, cos_(j), sin_(j), [u](Index k, int c, Real v) { u[4 * k + c] = v; });
+        }
+    }
 
    private:
-    // E at the particles of one column: from their own field, or from the diagonal's.
-    const Real* e_at(const Real* column, ParticleLayout layout) {
-      if (tau_field_ == TauField::per_tau) return field_.at_particles(column, layout);
+    void solve_diagonal() {
       if (!diagonal_) throw tsi::Error("vlasov-poisson-2d: the diagonal field was evaluated without the diagonal");
       if (!diagonal_solved_) {
         field_.solve(reinterpret_cast<const Real*>(diagonal_->data()), complex_layout);
         diagonal_solved_ = true;
       }
+    }
+    // E at the particles of one column: from their own field, or from the diagonal's.
+    const Real* e_at(const Real* column, ParticleLayout layout) {
+      if (tau_field_ == TauField::per_tau) return field_.at_particles(column, layout);
+      solve_diagonal();
       return field_.interpolate(column, layout);
     }
 
