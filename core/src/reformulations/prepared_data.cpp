@@ -105,13 +105,13 @@ void PreparedData::at(const Vector& v, Real s, Vector& out) {
 
 void PreparedData::low_order_data(const Vector& v, Real s, Vector& out) {
   // Order 2: U = v + eps (r1(v) - r1(v)(s)), r1 = A f_.(v), with f_tau of the constant grid v
-  // evaluated as the state's nonlinearity at the zero state shifted by v (out is that zero
-  // state: the evaluation reads it into its grid before it writes); order 1: U = v.
-  out.resize(grid_.size());
-  out.setZero();
+  // evaluated as the state's nonlinearity at the zero state shifted by v; order 1: U = v.
+  if (order_ >= 2)
+    grid_.nonlinear_of_constant(v, out, s);
+  else
+    out.setZero(grid_.size());
   Eigen::Map<Matrix> c(out.data(), dim_, columns_);
   if (order_ >= 2) {
-    grid_.nonlinear(out, &v, out, s);
     for (int j = 0; j < columns_; ++j) {
       const Complex a = grid_.antiderivative(j);
       if (a == Complex(0))

@@ -178,7 +178,17 @@ void TauGrid::on_grid_threads(In&& transform_in, Field&& evaluate, Out&& transfo
     if (error) std::rethrow_exception(error);
 }
 
-void TauGrid::nonlinear_by_rows(const Vector& y, const Vector* mean_shift, Vector& out) {
+void TauGrid::nonlinear_of_constant(const Vector& v, Vector& out, Real phase) {
+  if (!row_blocks_) {
+    out.setZero(size());
+    return nonlinear(out, &v, out, phase);
+  }
+  ++*evaluations_;
+  if (needs_diagonal_) set_diagonal(v);  // a constant grid's value at any tau
+  nonlinear_by_rows(nullptr, &v, out);
+}
+
+void TauGrid::nonlinear_by_rows(const Vector* y, const Vector* mean_shift, Vector& out) {
   out.resize(size());
   grid_field_->prepare_rows();
   const TauGridField& field = *grid_field_;
@@ -200,7 +210,10 @@ void TauGrid::nonlinear_by_rows(const Vector& y, const Vector* mean_shift, Vecto
       try {
         const Index r0 = blocks.block_begin(b), rn = blocks.rows_of(b);
         Eigen::Map<RealMatrix> values(buffer.data(), rn, n_tau_);
-        blocks.backward(y.data(), b, values.data());
+        if (y)
+          blocks.backward(y->data(), b, values.data());
+        else
+          values.setZero();
         if (mean_shift) values.colwise() += mean_shift->segment(r0, rn).real();
         field.evaluate_rows_real(values, r0);
         blocks.forward_unnormalised(values.data(), b, out.data());
@@ -215,7 +228,7 @@ void TauGrid::nonlinear_by_rows(const Vector& y, const Vector* mean_shift, Vecto
 }
 
 void TauGrid::nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& out) {
-  if (row_blocks_) return nonlinear_by_rows(y, mean_shift, out);
+  if (row_blocks_) return nonlinear_by_rows(&y, mean_shift, out);
   out.resize(size());
   const bool in_place = field_values_.size() == 0;
   const Real* field = in_place ? grid_values_.data() : field_values_.data();

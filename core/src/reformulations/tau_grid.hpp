@@ -45,6 +45,9 @@ class TauGrid {
   /// `phase`: tau on the diagonal at the evaluation's time (t/eps), for a field that reads
   /// U there (TauGridField::needs_diagonal).
   void nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, Real phase);
+  /// f_tau of the grid constant in tau, v at every tau: nonlinear(0, &v, out, phase), the same
+  /// numbers, without forming and reading a zero state where the grid goes by blocks of rows.
+  void nonlinear_of_constant(const Vector& v, Vector& out, Real phase);
 
   /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau), computed in W's storage where
   /// the model evaluates in place. A field that reads the diagonal reads W at tau = 0 (the
@@ -79,8 +82,9 @@ class TauGrid {
   /// nonlinear in the real layout.
   void nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& out);
   /// nonlinear in the real layout by blocks of rows (row_blocks_): a block's coefficients to
-  /// its values, f, and back, in a buffer per thread; the blocks split over threads_.
-  void nonlinear_by_rows(const Vector& y, const Vector* mean_shift, Vector& out);
+  /// its values, f, and back, in a buffer per thread; the blocks split over threads_. y null:
+  /// the zero state (the values are the shift's).
+  void nonlinear_by_rows(const Vector* y, const Vector* mean_shift, Vector& out);
   /// nonlinear on the tau grid split over threads_: each thread transforms its rows and
   /// evaluates the field on its columns (between barriers); the same numbers as the serial path.
   void nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out);
