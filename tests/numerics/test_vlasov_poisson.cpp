@@ -235,7 +235,7 @@ TEST_CASE("vlasov-poisson-2d: particles from a .npy N x 4 array and from the pee
 namespace {
 
 // Particles of the UA-PIC peer's raw dumps (tests/data/uapic: UAPIC.jl's fortran/bupdate.F90
-// with b = 1, N = 2048, built outside tsi; docs/pic.md says how), as an N x 4 array.
+// with b = 1, N = 2048, built outside tsi; tests/data/uapic/README.md says how), as an N x 4 array.
 Eigen::Array<double, Eigen::Dynamic, 4, Eigen::RowMajor> peer_particles(const std::string& name) {
   const std::string path = std::string(TSI_TEST_SOURCE_DIR) + "/tests/data/uapic/" + name;
   std::ifstream in(path, std::ios::binary);
