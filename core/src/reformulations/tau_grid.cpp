@@ -70,20 +70,23 @@ TauGrid::TauGrid(std::shared_ptr<const Model> model, int n_tau, bool real_layout
   }
   grid_field_ = model_->bind_tau_grid(taus_);
   needs_diagonal_ = grid_field_->needs_diagonal();
+  // A real field independent across groups of rows goes by blocks of 64 groups (64 particles x
+  // 16 tau points are 32 kB of values), the one binding on every thread: no grid of the
+  // state's size, no binding per thread.
+  if (const Index group = grid_field_->independent_row_group();
+      real_layout_ && grid_field_->evaluates_real() && group > 0) {
+    if (dim_ % group != 0)
+      throw Error("tau grid: the model's independent row groups (" + std::to_string(group) +
+                  " rows) do not divide its dimension " + std::to_string(dim_));
+    real_kernels_ = true;
+    row_blocks_ = std::make_unique<RealFftRows>(n_tau, dim_, 64 * group);
+    return;
+  }
   for (int p = 0; p <= threads_; ++p) column_begin_.push_back(static_cast<Index>(n_tau) * p / threads_);
   for (int p = 0; threads_ > 1 && p < threads_; ++p)
     column_fields_.push_back(model_->bind_tau_grid(taus_.segment(column_begin_[p], column_begin_[p + 1] - column_begin_[p])));
   if (real_layout_) {
     real_kernels_ = grid_field_->evaluates_real();
-    // A field independent across groups of rows goes by blocks of them: 64 groups (a block of
-    // 64 particles x 16 tau points is 32 kB of values), no grid of the state's size.
-    if (const Index group = grid_field_->independent_row_group(); real_kernels_ && group > 0) {
-      if (dim_ % group != 0)
-        throw Error("tau grid: the model's independent row groups (" + std::to_string(group) +
-                    " rows) do not divide its dimension " + std::to_string(dim_));
-      row_blocks_ = std::make_unique<RealFftRows>(n_tau, dim_, 64 * group);
-      return;
-    }
     grid_values_.setZero(dim_, n_tau);
     for (const auto& f : column_fields_) real_kernels_ = real_kernels_ && f->evaluates_real();
     bool in_place = real_kernels_ && grid_field_->in_place();
