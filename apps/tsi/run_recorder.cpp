@@ -175,7 +175,8 @@ bool RunRecorder::observe(long n, Real t, const Vector& y) {
     tracks_[k].max_rel_error = std::max(tracks_[k].max_rel_error, errors[k]);
   }
   const TwoScaleDiagnostics* tau = reformulation_.two_scale_diagnostics();  // no tau: both 0
-  const double roughness = tau ? to_double(tau->tau_roughness(y)) : 0.0;
+  const TauProfile profile = tau ? tau->tau_profile(y) : TauProfile{};
+  const double roughness = to_double(profile.roughness);
   roughness_max_ = std::max(roughness_max_, roughness);
   if (roughness > roughness_warn_ && !roughness_warned_) {
     roughness_warned_ = true;
@@ -190,7 +191,7 @@ bool RunRecorder::observe(long n, Real t, const Vector& y) {
   // the spread sits at 2.4e-6 while SE1 follows the solution, then grows a thousandfold within
   // 15 time units while the mass error goes from 1e-5 to 1, and the top of the tau spectrum
   // stays far below tau_roughness_warn.
-  const double spread = tau ? to_double(tau->tau_spread(y)) : 0.0;
+  const double spread = to_double(profile.spread);
   spread_max_ = std::max(spread_max_, spread);
   // The baseline is the first recorded step's spread (step output.every, not always step 1).
   if (!spread_baseline_set_) {

@@ -5,6 +5,8 @@
 #include <span>
 
 #include "tsi/diagonal.hpp"
+#include "tsi/export.hpp"
+#include "tsi/function_ref.hpp"
 #include "tsi/types.hpp"
 
 /// The vector arithmetic of the schemes and fixed-point solvers, in one place (as
@@ -80,7 +82,7 @@ inline void diagonal_linear_combination(const Vector* start, std::span<const Vec
 
 /// The same operations with a Diagonal (stored once per run of equal entries: the two-scale
 /// coefficients, n_tau values instead of dim x n_tau): the same products entry by entry, a run
-/// at a time (diagonals of different runs go entry by entry).
+/// at a time (diagonals of different runs go entry by entry), on the diagonal's threads.
 namespace detail {
 /// The run all of ds share, or 0 when they differ.
 inline Index common_run(std::initializer_list<const Diagonal*> ds) {
@@ -89,6 +91,24 @@ inline Index common_run(std::initializer_list<const Diagonal*> ds) {
     if (d->run() != run) return 0;
   return run;
 }
+/// The most threads any of ds carries.
+inline int common_threads(std::initializer_list<const Diagonal*> ds) {
+  int threads = 1;
+  for (const Diagonal* d : ds) threads = std::max(threads, d->threads());
+  return threads;
+}
+/// Calls body(begin, end) on `threads` contiguous ranges of [0, n) at the same time (OpenMP,
+/// in the core: a plugin needs no OpenMP of its own), or once on all of it.
+TSI_API void for_ranges(int threads, Index n, FunctionRef<void(Index, Index)> body);
+/// Calls piece(value, begin, count) for the entries [i0, i1) of each run of length r (r >= 1).
+template <class Piece>
+inline void for_run_pieces(Index r, Index i0, Index i1, Piece&& piece) {
+  for (Index lo = i0; lo < i1;) {
+    const Index b = lo / r, hi = std::min(i1, (b + 1) * r);
+    piece(b, lo, hi - lo);
+    lo = hi;
+  }
+}
 }  // namespace detail
 
 /// out = d . x (out may alias x).
@@ -96,11 +116,13 @@ inline void diagonal_multiply(const Diagonal& d, const Vector& x, Vector& out) {
   out.resize(x.size());
   const Index r = d.run();
   const Vector& v = d.values();
-  if (r == 1) {
-    out = v.cwiseProduct(x);
-    return;
-  }
-  for (Index b = 0; b < v.size(); ++b) out.segment(b * r, r) = v(b) * x.segment(b * r, r);
+  detail::for_ranges(d.threads(), x.size(), [&](Index i0, Index i1) {
+    if (r == 1) {
+      out.segment(i0, i1 - i0) = v.segment(i0, i1 - i0).cwiseProduct(x.segment(i0, i1 - i0));
+      return;
+    }
+    detail::for_run_pieces(r, i0, i1, [&](Index b, Index lo, Index m) { out.segment(lo, m) = v(b) * x.segment(lo, m); });
+  });
 }
 
 /// out = x + d . y (out may alias x or y).
@@ -108,11 +130,15 @@ inline void diagonal_multiply_add(const Vector& x, const Diagonal& d, const Vect
   out.resize(x.size());
   const Index r = d.run();
   const Vector& v = d.values();
-  if (r == 1) {
-    out = x + v.cwiseProduct(y);
-    return;
-  }
-  for (Index b = 0; b < v.size(); ++b) out.segment(b * r, r) = x.segment(b * r, r) + v(b) * y.segment(b * r, r);
+  detail::for_ranges(d.threads(), x.size(), [&](Index i0, Index i1) {
+    if (r == 1) {
+      const Index m = i1 - i0;
+      out.segment(i0, m) = x.segment(i0, m) + v.segment(i0, m).cwiseProduct(y.segment(i0, m));
+      return;
+    }
+    detail::for_run_pieces(r, i0, i1,
+                           [&](Index b, Index lo, Index m) { out.segment(lo, m) = x.segment(lo, m) + v(b) * y.segment(lo, m); });
+  });
 }
 
 /// out = d1 . x1 + d2 . x2 (out may alias x1 or x2).
@@ -121,14 +147,18 @@ inline void diagonal_combination(const Diagonal& d1, const Vector& x1, const Dia
   out.resize(x1.size());
   const Index r = detail::common_run({&d1, &d2});
   const Vector &v1 = d1.values(), &v2 = d2.values();
-  if (r == 1) {
-    out = v1.cwiseProduct(x1) + v2.cwiseProduct(x2);
-  } else if (r > 1) {
-    for (Index b = 0; b < v1.size(); ++b)
-      out.segment(b * r, r) = v1(b) * x1.segment(b * r, r) + v2(b) * x2.segment(b * r, r);
-  } else {
-    for (Index i = 0; i < x1.size(); ++i) out(i) = d1(i) * x1(i) + d2(i) * x2(i);
-  }
+  detail::for_ranges(detail::common_threads({&d1, &d2}), x1.size(), [&](Index i0, Index i1) {
+    if (r == 1) {
+      const Index m = i1 - i0;
+      out.segment(i0, m) = v1.segment(i0, m).cwiseProduct(x1.segment(i0, m)) + v2.segment(i0, m).cwiseProduct(x2.segment(i0, m));
+    } else if (r > 1) {
+      detail::for_run_pieces(r, i0, i1, [&](Index b, Index lo, Index m) {
+        out.segment(lo, m) = v1(b) * x1.segment(lo, m) + v2(b) * x2.segment(lo, m);
+      });
+    } else {
+      for (Index i = i0; i < i1; ++i) out(i) = d1(i) * x1(i) + d2(i) * x2(i);
+    }
+  });
 }
 
 /// out = d1 . x1 + d2 . x2 + d3 . x3 (out may alias any x).
@@ -137,15 +167,19 @@ inline void diagonal_combination(const Diagonal& d1, const Vector& x1, const Dia
   out.resize(x1.size());
   const Index r = detail::common_run({&d1, &d2, &d3});
   const Vector &v1 = d1.values(), &v2 = d2.values(), &v3 = d3.values();
-  if (r == 1) {
-    out = v1.cwiseProduct(x1) + v2.cwiseProduct(x2) + v3.cwiseProduct(x3);
-  } else if (r > 1) {
-    for (Index b = 0; b < v1.size(); ++b)
-      out.segment(b * r, r) =
-          v1(b) * x1.segment(b * r, r) + v2(b) * x2.segment(b * r, r) + v3(b) * x3.segment(b * r, r);
-  } else {
-    for (Index i = 0; i < x1.size(); ++i) out(i) = d1(i) * x1(i) + d2(i) * x2(i) + d3(i) * x3(i);
-  }
+  detail::for_ranges(detail::common_threads({&d1, &d2, &d3}), x1.size(), [&](Index i0, Index i1) {
+    if (r == 1) {
+      const Index m = i1 - i0;
+      out.segment(i0, m) = v1.segment(i0, m).cwiseProduct(x1.segment(i0, m)) +
+                           v2.segment(i0, m).cwiseProduct(x2.segment(i0, m)) + v3.segment(i0, m).cwiseProduct(x3.segment(i0, m));
+    } else if (r > 1) {
+      detail::for_run_pieces(r, i0, i1, [&](Index b, Index lo, Index m) {
+        out.segment(lo, m) = v1(b) * x1.segment(lo, m) + v2(b) * x2.segment(lo, m) + v3(b) * x3.segment(lo, m);
+      });
+    } else {
+      for (Index i = i0; i < i1; ++i) out(i) = d1(i) * x1(i) + d2(i) * x2(i) + d3(i) * x3(i);
+    }
+  });
 }
 
 /// out = start + sum_j d_j . x_j over k pairs (start may be null: none), in one pass over memory,
@@ -155,37 +189,42 @@ inline void diagonal_linear_combination(const Vector* start, std::span<const Dia
   const Index n = start ? start->size() : x.front()->size();
   out.resize(n);
   Index r = d.empty() ? 1 : d.front()->run();
-  for (const Diagonal* dj : d)
+  int threads = 1;
+  for (const Diagonal* dj : d) {
     if (dj->run() != r) r = 0;
-  if (r == 0) {  // runs that differ: entry by entry
-    for (Index i = 0; i < n; ++i) {
-      Complex acc = start ? (*start)(i) : Complex(0);
-      for (size_t j = 0; j < x.size(); ++j) acc += (*d[j])(i) * (*x[j])(i);
-      out(i) = acc;
-    }
-    return;
+    threads = std::max(threads, dj->threads());
   }
-  constexpr Index block = 256;
-  Eigen::Matrix<Complex, block, 1> sum;
-  // Blocks of at most `block` entries inside one run: every coefficient is one value there
-  // (r = 1: a segment of each diagonal).
-  for (Index b = 0; b < n;) {
-    const Index run_end = r == 1 ? n : (b / r + 1) * r;
-    const Index m = std::min(block, run_end - b);
-    auto acc = sum.head(m);
-    if (start)
-      acc = start->segment(b, m);
-    else
-      acc.setZero();
-    if (r == 1) {
-      for (size_t j = 0; j < x.size(); ++j) acc += d[j]->values().segment(b, m).cwiseProduct(x[j]->segment(b, m));
-    } else {
-      const Index v = b / r;
-      for (size_t j = 0; j < x.size(); ++j) acc += d[j]->values()(v) * x[j]->segment(b, m);
+  detail::for_ranges(threads, n, [&](Index i0, Index i1) {
+    if (r == 0) {  // runs that differ: entry by entry
+      for (Index i = i0; i < i1; ++i) {
+        Complex acc = start ? (*start)(i) : Complex(0);
+        for (size_t j = 0; j < x.size(); ++j) acc += (*d[j])(i) * (*x[j])(i);
+        out(i) = acc;
+      }
+      return;
     }
-    out.segment(b, m) = acc;
-    b += m;
-  }
+    constexpr Index block = 256;
+    Eigen::Matrix<Complex, block, 1> sum;
+    // Blocks of at most `block` entries inside one run: every coefficient is one value there
+    // (r = 1: a segment of each diagonal).
+    for (Index b = i0; b < i1;) {
+      const Index run_end = r == 1 ? i1 : std::min(i1, (b / r + 1) * r);
+      const Index m = std::min(block, run_end - b);
+      auto acc = sum.head(m);
+      if (start)
+        acc = start->segment(b, m);
+      else
+        acc.setZero();
+      if (r == 1) {
+        for (size_t j = 0; j < x.size(); ++j) acc += d[j]->values().segment(b, m).cwiseProduct(x[j]->segment(b, m));
+      } else {
+        const Index v = b / r;
+        for (size_t j = 0; j < x.size(); ++j) acc += d[j]->values()(v) * x[j]->segment(b, m);
+      }
+      out.segment(b, m) = acc;
+      b += m;
+    }
+  });
 }
 
 /// True when every entry of x is finite: one pass, no allocation (the check a run makes at

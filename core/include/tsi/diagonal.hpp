@@ -56,6 +56,22 @@ class Diagonal {
       return plus;
     }
   }
+  /// Threads its entrywise operations in tsi::algebra may use (1: none). The two-scale L
+  /// carries the run's tau-grid threads, and the functions of it (diagonal_function, like())
+  /// keep them, so that a scheme's combinations of 10^7 unknowns go on the run's threads; the
+  /// numbers are the same on any number.
+  int threads() const { return threads_; }
+  Diagonal with_threads(int threads) const {
+    Diagonal d = *this;
+    d.threads_ = threads < 1 ? 1 : threads;
+    return d;
+  }
+  /// An operator of the same run and threads with other values (one per run), without pairs.
+  Diagonal like(Vector values) const {
+    Diagonal d(std::move(values), run_);
+    d.threads_ = threads_;
+    return d;
+  }
   /// Its memory in vectors of its size (1 / run()).
   double state_fraction() const { return size() ? static_cast<double>(values_.size()) / static_cast<double>(size()) : 0.0; }
 
@@ -63,6 +79,7 @@ class Diagonal {
   Vector values_;
   Index run_ = 1;
   RealVector pairs_;  // empty, or one per stored value
+  int threads_ = 1;
 };
 
 /// out_i = f(scale * lambda_i): a function of the diagonal operator scale * L, evaluated
@@ -72,7 +89,7 @@ void diagonal_function(const Diagonal& lambda, Real scale, F&& f, Diagonal& out)
   const Vector& v = lambda.values();
   Vector values(v.size());
   for (Index i = 0; i < v.size(); ++i) values(i) = lambda.function_at(i, scale, f);
-  out = Diagonal(std::move(values), lambda.run());
+  out = lambda.like(std::move(values));
 }
 
 /// The same with one value per unknown (a coefficient a scheme stores as a Vector).
@@ -100,7 +117,7 @@ void diagonal_functions(const Diagonal& lambda, Real scale, F&& f, std::span<Dia
     const auto w = lambda.function_at(i, scale, f);
     for (size_t j = 0; j < outs.size(); ++j) values[j](i) = w[j];
   }
-  for (size_t j = 0; j < outs.size(); ++j) *outs[j] = Diagonal(std::move(values[j]), lambda.run());
+  for (size_t j = 0; j < outs.size(); ++j) *outs[j] = lambda.like(std::move(values[j]));
 }
 
 /// The same for a Vector of the diagonal's entries, each out sized like lambda.

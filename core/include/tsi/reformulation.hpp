@@ -9,11 +9,19 @@
 
 namespace tsi {
 
+/// The tau monitors of one state, from one pass over it (TwoScaleDiagnostics::tau_profile).
+struct TauProfile {
+  Real roughness = 0.0;  ///< tau_roughness
+  Real spread = 0.0;     ///< tau_spread
+};
+
 /// What a two-scale reformulation reports besides its problem: its tau monitors and what its
 /// preparation did. The run's observers (the recorder) ask it at their own cadence.
 class TSI_API TwoScaleDiagnostics {
  public:
   virtual ~TwoScaleDiagnostics() = default;
+  /// Both monitors below from one pass over y (a particle state is 10^8 numbers).
+  virtual TauProfile tau_profile(const Vector& y) const = 0;
   /// Fraction of the energy of y in the top quarter of the tau spectrum.
   virtual Real tau_roughness(const Vector& y) const = 0;
   /// Fraction of the energy of y away from its tau mean (the non-zero tau modes). Each

@@ -106,21 +106,21 @@ void PreparedData::at(const Vector& v, Real s, Vector& out) {
 void PreparedData::low_order_data(const Vector& v, Real s, Vector& out) {
   // Order 2: U = v + eps (r1(v) - r1(v)(s)), r1 = A f_.(v), with f_tau of the constant grid v
   // evaluated as the state's nonlinearity at the zero state shifted by v; order 1: U = v.
-  if (order_ >= 2)
-    grid_.nonlinear_of_constant(v, out, s);
-  else
-    out.setZero(grid_.size());
-  Eigen::Map<Matrix> c(out.data(), dim_, columns_);
+  // The columns scaled by eps A and their value at s come in the same pass (ColumnFinish).
   if (order_ >= 2) {
+    TauGrid::ColumnFinish finish;
     for (int j = 0; j < columns_; ++j) {
       const Complex a = grid_.antiderivative(j);
-      if (a == Complex(0))
-        c.col(j).setZero();
-      else
-        c.col(j) *= eps_ * a;
+      finish.factors.push_back(a == Complex(0) ? Complex(0) : eps_ * a);
     }
-    c.col(0) -= grid_.evaluate(c, s);
+    finish.phase = s;
+    finish.at_phase = &at_s_;
+    grid_.nonlinear_of_constant(v, out, s, &finish);
+  } else {
+    out.setZero(grid_.size());
   }
+  Eigen::Map<Matrix> c(out.data(), dim_, columns_);
+  if (order_ >= 2) c.col(0) -= at_s_;
   c.col(0) += v;
 }
 

@@ -86,6 +86,7 @@ class PreparedData {
   int n_tau_;
   int columns_;
   Real eps_;
+  Vector at_s_;  // low_order_data: its correction at tau = s, kept between re-preparations
   Vector remainder_;  // i omega per model coordinate (empty without a remainder)
   int order_;
   DataMethod method_;

@@ -181,18 +181,41 @@ void TauGrid::on_grid_threads(In&& transform_in, Field&& evaluate, Out&& transfo
     if (error) std::rethrow_exception(error);
 }
 
-void TauGrid::nonlinear_of_constant(const Vector& v, Vector& out, Real phase) {
+void TauGrid::nonlinear_of_constant(const Vector& v, Vector& out, Real phase, const ColumnFinish* finish) {
   if (!row_blocks_) {
     out.setZero(size());
-    return nonlinear(out, &v, out, phase);
+    nonlinear(out, &v, out, phase);
+    if (finish) {
+      if (finish->at_phase) finish->at_phase->resize(dim_);
+      finish_rows(*finish, evaluation_factors(columns_, finish->phase), out.data(), 0, dim_);
+    }
+    return;
   }
   ++*evaluations_;
   if (needs_diagonal_) set_diagonal(v);  // a constant grid's value at any tau
-  nonlinear_by_rows(nullptr, &v, out);
+  nonlinear_by_rows(nullptr, &v, out, finish);
 }
 
-void TauGrid::nonlinear_by_rows(const Vector* y, const Vector* mean_shift, Vector& out) {
+void TauGrid::finish_rows(const ColumnFinish& finish, const std::vector<Complex>& phase_factors, Complex* c, Index r0,
+                          Index rn) const {
+  for (int j = 0; j < columns_; ++j) {
+    Eigen::Map<Vector> column(c + j * dim_ + r0, rn);
+    const Complex factor = finish.factors[static_cast<std::size_t>(j)];
+    if (factor == Complex(0))
+      column.setZero();
+    else
+      column *= factor;
+  }
+  if (finish.at_phase) evaluate_rows(c, columns_, phase_factors, r0, rn, finish.at_phase->data() + r0);
+}
+
+void TauGrid::nonlinear_by_rows(const Vector* y, const Vector* mean_shift, Vector& out, const ColumnFinish* finish) {
   out.resize(size());
+  std::vector<Complex> phase_factors;
+  if (finish) {
+    if (finish->at_phase) finish->at_phase->resize(dim_);
+    phase_factors = evaluation_factors(columns_, finish->phase);
+  }
   grid_field_->prepare_rows();
   const TauGridField& field = *grid_field_;
   const RealFftRows& blocks = *row_blocks_;
@@ -221,6 +244,7 @@ void TauGrid::nonlinear_by_rows(const Vector* y, const Vector* mean_shift, Vecto
         field.evaluate_rows_real(values, r0);
         blocks.forward_unnormalised(values.data(), b, out.data());
         for (int j = 0; j < columns_; ++j) out.segment(j * dim_ + r0, rn) *= scale;
+        if (finish) finish_rows(*finish, phase_factors, out.data(), r0, rn);  // while the rows are in cache
       } catch (...) {
         error = std::current_exception();
       }
@@ -304,11 +328,27 @@ Matrix TauGrid::all_modes(ConstMatrixRef stored) const {
 }
 
 Real TauGrid::coefficient_norm(const Vector& y, bool without_mean) const {
+  const RealVector energies = column_energies(y);
+  return std::sqrt(energies.tail(columns_ - (without_mean ? 1 : 0)).sum());
+}
+
+RealVector TauGrid::column_energies(const Vector& y) const {
   const Eigen::Map<const Matrix> c(y.data(), dim_, columns_);
-  Real sum = 0.0;
-  for (int j = without_mean ? 1 : 0; j < columns_; ++j)
-    sum += (real_layout_ && j > 0 && 2 * j < n_tau_ ? 2.0 : 1.0) * c.col(j).squaredNorm();
-  return norm_from_squares(sum);
+  constexpr Index block = Index(1) << 14;  // rows per partial sum: fixed, so threads change nothing
+  const Index blocks = (dim_ + block - 1) / block;
+  RealMatrix partial(blocks, columns_);
+#if defined(_OPENMP)
+#pragma omp parallel for num_threads(threads_) schedule(static) if (threads_ > 1 && blocks > 1)
+#endif
+  for (Index b = 0; b < blocks; ++b) {
+    const Index r0 = b * block, rn = std::min(block, dim_ - r0);
+    for (int j = 0; j < columns_; ++j) partial(b, j) = c.col(j).segment(r0, rn).squaredNorm();
+  }
+  RealVector energies(columns_);
+  for (int j = 0; j < columns_; ++j)
+    energies(j) = (real_layout_ && j > 0 && 2 * j < n_tau_ ? 2.0 : 1.0) * partial.col(j).sum();
+  if (collective_) collective_->sum(energies.data(), columns_);
+  return energies;
 }
 
 Real TauGrid::norm_from_squares(Real squares) const {
@@ -357,14 +397,50 @@ Complex TauGrid::antiderivative(int j) const {
 }
 
 
-Vector TauGrid::evaluate(ConstMatrixRef c, Real tau) const {
-  Vector value = Vector::Zero(dim_);
-  const bool real = c.cols() != n_tau_;  // the real layout: modes k and -k together, 2 Re(c_k e^{i k tau})
-  std::vector<Complex> factors(static_cast<std::size_t>(c.cols()));
-  for (int j = 0; j < c.cols(); ++j)
+std::vector<Complex> TauGrid::evaluation_factors(Index columns, Real tau) const {
+  const bool real = columns != n_tau_;  // the real layout: modes k and -k together, 2 Re(c_k e^{i k tau})
+  std::vector<Complex> factors(static_cast<std::size_t>(columns));
+  for (int j = 0; j < columns; ++j)
     factors[static_cast<std::size_t>(j)] = 2 * j == n_tau_ ? Complex(std::cos(0.5 * n_tau_ * tau))  // half at +-n/2
                                            : real          ? std::polar(Real(1), j * tau)
                                                            : std::polar(Real(1), wave_numbers_(j) * tau);
+  return factors;
+}
+
+void TauGrid::evaluate_rows(const Complex* c, Index columns, const std::vector<Complex>& factors, Index r0, Index rn,
+                            Complex* value) const {
+  if (columns != n_tau_) {  // the real parts only, mode by mode (the imaginary parts stay 0)
+    Real* v = reinterpret_cast<Real*>(value);
+    for (Index r = 0; r < rn; ++r) v[2 * r + 1] = 0.0;
+    for (int j = 0; j < columns; ++j) {
+      const Real* x = reinterpret_cast<const Real*>(c + j * dim_ + r0);
+      const Complex f = factors[static_cast<std::size_t>(j)];
+      if (j == 0) {
+        for (Index r = 0; r < rn; ++r) v[2 * r] = x[2 * r];
+      } else if (2 * j == n_tau_) {  // stored with the half of both signs: its real part
+        for (Index r = 0; r < rn; ++r) v[2 * r] += f.real() * x[2 * r];
+      } else {  // 2 Re(c_k e^{i k tau})
+        const Real re = 2.0 * f.real(), im = 2.0 * f.imag();
+        for (Index r = 0; r < rn; ++r) v[2 * r] += re * x[2 * r] - im * x[2 * r + 1];
+      }
+    }
+    return;
+  }
+  Eigen::Map<Vector> v(value, rn);
+  v.setZero();
+  for (int j = 0; j < columns; ++j) {
+    const Complex f = factors[static_cast<std::size_t>(j)];
+    const Eigen::Map<const Vector> col(c + j * dim_ + r0, rn);
+    if (2 * j == n_tau_)
+      v += col * f.real();
+    else
+      v += col * f;
+  }
+}
+
+Vector TauGrid::evaluate(ConstMatrixRef c, Real tau) const {
+  Vector value(dim_);
+  const std::vector<Complex> factors = evaluation_factors(c.cols(), tau);
   // By blocks of rows, each summed over the modes in order (the same numbers on any number of
   // threads): a particle state read back every step is 10^7 rows.
   constexpr Index block = 1 << 14;
@@ -373,32 +449,8 @@ Vector TauGrid::evaluate(ConstMatrixRef c, Real tau) const {
 #pragma omp parallel for num_threads(threads_) schedule(static) if (threads_ > 1 && blocks > 1)
 #endif
   for (Index b = 0; b < blocks; ++b) {
-    const Index r0 = b * block, rn = std::min(block, dim_ - r0);
-    if (real) {  // the real parts only, mode by mode (the imaginary parts stay 0)
-      Real* v = reinterpret_cast<Real*>(value.data() + r0);
-      for (int j = 0; j < c.cols(); ++j) {
-        const Real* x = reinterpret_cast<const Real*>(c.col(j).data() + r0);
-        const Complex f = factors[static_cast<std::size_t>(j)];
-        if (j == 0) {
-          for (Index r = 0; r < rn; ++r) v[2 * r] = x[2 * r];
-        } else if (2 * j == n_tau_) {  // stored with the half of both signs: its real part
-          for (Index r = 0; r < rn; ++r) v[2 * r] += f.real() * x[2 * r];
-        } else {  // 2 Re(c_k e^{i k tau})
-          const Real re = 2.0 * f.real(), im = 2.0 * f.imag();
-          for (Index r = 0; r < rn; ++r) v[2 * r] += re * x[2 * r] - im * x[2 * r + 1];
-        }
-      }
-      continue;
-    }
-    auto v = value.segment(r0, rn);
-    for (int j = 0; j < c.cols(); ++j) {
-      const Complex f = factors[static_cast<std::size_t>(j)];
-      const auto col = c.col(j).segment(r0, rn);
-      if (2 * j == n_tau_)
-        v += col * f.real();
-      else
-        v += col * f;
-    }
+    const Index r0 = b * block;
+    evaluate_rows(c.data(), c.cols(), factors, r0, std::min(block, dim_ - r0), value.data() + r0);
   }
   return value;
 }

@@ -45,9 +45,18 @@ class TauGrid {
   /// `phase`: tau on the diagonal at the evaluation's time (t/eps), for a field that reads
   /// U there (TauGridField::needs_diagonal).
   void nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, Real phase);
+  /// What nonlinear_of_constant does to the coefficients while they are in cache: column j
+  /// times factors[j] (a factor 0 sets it to 0), then their value at tau = phase into
+  /// *at_phase (evaluate's numbers). The order-2 prepared data in one pass.
+  struct ColumnFinish {
+    std::vector<Complex> factors;
+    Real phase = 0.0;
+    Vector* at_phase = nullptr;
+  };
   /// f_tau of the grid constant in tau, v at every tau: nonlinear(0, &v, out, phase), the same
-  /// numbers, without forming and reading a zero state where the grid goes by blocks of rows.
-  void nonlinear_of_constant(const Vector& v, Vector& out, Real phase);
+  /// numbers, without forming and reading a zero state where the grid goes by blocks of rows;
+  /// then `finish` (none: null).
+  void nonlinear_of_constant(const Vector& v, Vector& out, Real phase, const ColumnFinish* finish = nullptr);
 
   /// Coefficients of f_tau(W(tau)) for grid values W (d x n_tau), computed in W's storage where
   /// the model evaluates in place. A field that reads the diagonal reads W at tau = 0 (the
@@ -64,6 +73,10 @@ class TauGrid {
   Matrix all_modes(ConstMatrixRef stored) const;
   /// The norm of the coefficients of a state as if all N_tau modes were stored.
   Real coefficient_norm(const Vector& y, bool without_mean = false) const;
+  /// The squared norm of each stored column of a state's coefficients, weighted as if all N_tau
+  /// modes were stored, over every process of a split run: one pass on the grid's threads, the
+  /// same numbers on any number of them (sums by fixed blocks of rows, in order).
+  RealVector column_energies(const Vector& y) const;
   /// sqrt(squares) over every process of a split run (Context::collective): the 2-norm of a
   /// state, or of tau data, from the sum of its squares on this process's rows.
   Real norm_from_squares(Real squares) const;
@@ -84,7 +97,15 @@ class TauGrid {
   /// nonlinear in the real layout by blocks of rows (row_blocks_): a block's coefficients to
   /// its values, f, and back, in a buffer per thread; the blocks split over threads_. y null:
   /// the zero state (the values are the shift's).
-  void nonlinear_by_rows(const Vector* y, const Vector* mean_shift, Vector& out);
+  void nonlinear_by_rows(const Vector* y, const Vector* mean_shift, Vector& out, const ColumnFinish* finish = nullptr);
+  /// finish on rows r0 .. r0 + rn of coefficients c (the state's layout).
+  void finish_rows(const ColumnFinish& finish, const std::vector<Complex>& phase_factors, Complex* c, Index r0,
+                   Index rn) const;
+  /// The factors of evaluate's sum at tau, one per stored column.
+  std::vector<Complex> evaluation_factors(Index columns, Real tau) const;
+  /// evaluate's sum for rows r0 .. r0 + rn of coefficients c (columns of dim_ rows) into value.
+  void evaluate_rows(const Complex* c, Index columns, const std::vector<Complex>& factors, Index r0, Index rn,
+                     Complex* value) const;
   /// nonlinear on the tau grid split over threads_: each thread transforms its rows and
   /// evaluates the field on its columns (between barriers); the same numbers as the serial path.
   void nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out);

@@ -32,7 +32,7 @@ TwoScale::TwoScale(std::shared_ptr<const Model> model, int n_tau, int initial_da
     multipliers.segment(j * dim, dim).setConstant(Complex(0.0, -k / eps_));
     if (remainder_.size()) multipliers.segment(j * dim, dim) += remainder_;
   }
-  multipliers_ = Diagonal(std::move(multipliers), run);
+  multipliers_ = Diagonal(std::move(multipliers), run).with_threads(grid_.threads());  // the schemes' combinations too
 }
 
 void TwoScale::average_nyquist() {
@@ -85,24 +85,17 @@ Vector TwoScale::read_back(const Vector& y, Real t) {
   return model_->linear_flow(tau, grid_.evaluate(Eigen::Map<const Matrix>(y.data(), grid_.dim(), grid_.columns()), tau));
 }
 
-Real TwoScale::tau_roughness(const Vector& y) const {
-  const int columns = grid_.columns(), n_tau = grid_.n_tau();
-  const Eigen::Map<const Matrix> c(y.data(), grid_.dim(), columns);
-  Real total = 0.0, top = 0.0;
-  for (int j = 0; j < columns; ++j) {
-    const Real e = (grid_.real_layout() && j > 0 && 2 * j < n_tau ? 2.0 : 1.0) * c.col(j).squaredNorm();
-    total += e;
-    if (8.0 * std::abs(grid_.wave_numbers()(j)) > 3.0 * n_tau) top += e;  // |k| > 3/8 n: top quarter
-  }
-  // Over every process of a split run (each sum a square of its norm).
-  total = std::pow(grid_.norm_from_squares(total), 2);
-  top = std::pow(grid_.norm_from_squares(top), 2);
-  return total > 0.0 ? top / total : 0.0;
+TauProfile TwoScale::tau_profile(const Vector& y) const {
+  const RealVector energies = grid_.column_energies(y);  // one pass, summed over every process
+  const Real total = energies.sum();
+  Real top = 0.0;
+  for (int j = 0; j < grid_.columns(); ++j)
+    if (8.0 * std::abs(grid_.wave_numbers()(j)) > 3.0 * grid_.n_tau()) top += energies(j);  // |k| > 3/8 n: top quarter
+  if (!(total > 0.0)) return {0.0, 0.0};
+  return {top / total, energies.tail(grid_.columns() - 1).sum() / total};
 }
 
-Real TwoScale::tau_spread(const Vector& y) const {
-  const Real total = std::pow(grid_.coefficient_norm(y), 2);
-  return total > 0.0 ? std::pow(grid_.coefficient_norm(y, true), 2) / total : 0.0;
-}
+Real TwoScale::tau_roughness(const Vector& y) const { return tau_profile(y).roughness; }
+Real TwoScale::tau_spread(const Vector& y) const { return tau_profile(y).spread; }
 
 }  // namespace tsi

@@ -68,6 +68,7 @@ class TwoScale final : public Reformulation, public TwoScaleDiagnostics {
   /// u(t) = e^{JM t/eps} U(t, t/eps), U evaluated off the grid by its interpolant.
   Vector read_back(const Vector& y, Real t) override;
   const TwoScaleDiagnostics* two_scale_diagnostics() const override { return this; }
+  TauProfile tau_profile(const Vector& y) const override;
   Real tau_roughness(const Vector& y) const override;
   Real tau_spread(const Vector& y) const override;
   /// Re-prepares U when the rule says so: v_n = U(t_n, s_n), s_n = t_n/eps mod 2 pi, and U

@@ -9,6 +9,7 @@
 // f_tau(x, y) = (R(tau) y, R(-tau) E(x)).
 #include <bit>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 
@@ -138,16 +139,31 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
       constexpr Index chunk = 64;  // particles per interpolation: E for them on the stack
       Real e[2 * chunk];
       const Index particles = values.rows() / 4;
-      for (Index j = 0; j < values.cols(); ++j)
-        for (Index k0 = 0; k0 < particles; k0 += chunk) {
-          const Index m = std::min(chunk, particles - k0);
+      for (Index k0 = 0; k0 < particles; k0 += chunk) {
+        const Index m = std::min(chunk, particles - k0);
+        // Where every column holds the same positions (the grid constant in tau that re-preparation
+        // evaluates: e^{tau A} turns v alone), E is the same at every tau: interpolated once.
+        const bool one_field = same_positions(values, 4 * k0, m);
+        for (Index j = 0; j < values.cols(); ++j) {
           Real* u = values.col(j).data() + 4 * k0;
-          field_.interpolate_into(u, real_layout, m, e);
+          if (j == 0 || !one_field) field_.interpolate_into(u, real_layout, m, e);
           filtered_column(e, m, u, real_layout, cos_(j), sin_(j), [u](Index k, int c, Real v) { u[4 * k + c] = v; });
         }
+      }
     }
 
    private:
+    // True when the m particles from row r0 on have bit for bit the positions of column 0 in
+    // every column (a grid that varies in tau differs at its first particle: one comparison).
+    static bool same_positions(tsi::RealMatrixRef values, Index r0, Index m) {
+      for (Index j = 1; j < values.cols(); ++j)
+        for (Index k = 0; k < m; ++k)
+          for (Index c = 0; c < 2; ++c)
+            if (std::bit_cast<std::uint64_t>(values(r0 + 4 * k + c, j)) !=
+                std::bit_cast<std::uint64_t>(values(r0 + 4 * k + c, 0)))
+              return false;
+      return true;
+    }
     void solve_diagonal() {
       if (!diagonal_) throw tsi::Error("vlasov-poisson-2d: the diagonal field was evaluated without the diagonal");
       if (!diagonal_solved_) {

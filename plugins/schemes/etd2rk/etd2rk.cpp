@@ -31,7 +31,7 @@ class Etd2rk final : public tsi::Stepper {
     tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_);
     tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi1(z); }, p1_);
     tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi2(z); }, p2_);
-    p1_minus_p2_ = tsi::Diagonal(p1_.values() - p2_.values(), lambda.run());
+    p1_minus_p2_ = lambda.like(p1_.values() - p2_.values());
   }
 
   void step(Real t, Vector& y) override {

@@ -48,10 +48,10 @@ class Fd final : public tsi::Stepper {
       cayley(i) = half_turn * half_turn * (Real(1) + z) * inv;
       full_inverse(i) = h * half_turn * inv;
     }
-    inverse_ = tsi::Diagonal(std::move(inverse), run);
-    half_inverse_ = tsi::Diagonal(std::move(half_inverse), run);
-    cayley_ = tsi::Diagonal(std::move(cayley), run);
-    full_inverse_ = tsi::Diagonal(std::move(full_inverse), run);
+    inverse_ = tsi::Diagonal(std::move(inverse), run).with_threads(lambda.threads());
+    half_inverse_ = tsi::Diagonal(std::move(half_inverse), run).with_threads(lambda.threads());
+    cayley_ = tsi::Diagonal(std::move(cayley), run).with_threads(lambda.threads());
+    full_inverse_ = tsi::Diagonal(std::move(full_inverse), run).with_threads(lambda.threads());
   }
 
   void step(Real t, Vector& y) override {

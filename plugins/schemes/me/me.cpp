@@ -25,8 +25,8 @@ class Me final : public tsi::Stepper {
     tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_);
     tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi1(z); }, p1_);
     tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi2(z); }, p2_);
-    p12_ = tsi::Diagonal(p1_.values() + p2_.values(), lambda.run());
-    minus_p2_ = tsi::Diagonal(-p2_.values(), lambda.run());
+    p12_ = lambda.like(p1_.values() + p2_.values());
+    minus_p2_ = lambda.like(-p2_.values());
   }
 
   void reset() override { has_previous_ = false; }
