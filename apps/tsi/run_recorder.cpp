@@ -160,7 +160,7 @@ bool RunRecorder::observe(long n, Real t, const Vector& y) {
                            t, n, t_, steps_, every_);
     return false;
   }
-  const Vector u = reformulation_.read_back(y, t);
+  Vector u = reformulation_.read_back(y, t);
   Real values[3] = {0, 0, 0};
   if (hamiltonian_) values[0] = model_.energy(u), values[1] = model_.oscillatory_energy(u), values[2] = model_.mass(u);
   if (!everywhere(u.allFinite() && std::isfinite(values[0] + values[1] + values[2]))) {
@@ -207,11 +207,11 @@ bool RunRecorder::observe(long n, Real t, const Vector& y) {
         "or with large h; a smaller h or another scheme may delay it)",
         t, spread_baseline_, spread, spread_growth_warn_));
   }
-  u_ = u;
+  u_.swap(u);  // no copy of a state of 10^7 numbers
   steps_ = n;
   t_ = to_double(t);
   for (auto& d : declared_) {
-    d.final = d.invariant.value(u);
+    d.final = d.invariant.value(u_);
     d.change = to_double(std::abs(d.final - d.initial) / (d.relative ? std::abs(d.initial) : Real(1)));
     d.max_change = std::max(d.max_change, d.change);
     d.min = std::min(d.min, d.final);

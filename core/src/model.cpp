@@ -188,6 +188,14 @@ Vector Model::linear_flow(Real tau, const Vector& u) const {
   return states.col(0);
 }
 
+Vector Model::linear_flow(Real tau, Vector&& u) const {
+  RealVector taus(1);
+  taus(0) = tau;
+  Eigen::Map<Matrix> state(u.data(), u.size(), 1);
+  linear_flow(taus, state);
+  return std::move(u);
+}
+
 Vector Model::nonlinear_field(const Vector& u) const {
   Matrix out(u.size(), 1);
   nonlinear_field(Matrix(u), out);

@@ -98,6 +98,8 @@ class TSI_API Model {
 
   /// e^{A tau} applied to one state.
   Vector linear_flow(Real tau, const Vector& u) const;
+  /// The same in u's own storage (a read-back of 10^7 numbers: no copy).
+  Vector linear_flow(Real tau, Vector&& u) const;
   /// f(u) for one state.
   Vector nonlinear_field(const Vector& u) const;
   /// f_tau(u) = e^{-A tau} f(e^{A tau} u) for column j at tau = taus[j]; `states` is scratch.

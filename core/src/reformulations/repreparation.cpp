@@ -12,7 +12,8 @@ bool Repreparer::after_step(long n, Real t, Vector& y) {
   if (rule_.mode == Repreparation::Mode::Auto && (n - last_prepared_) % rule_.min_gap != 0)
     return false;
   const Real s = fast_phase(t, eps_);
-  const Vector v = grid_.evaluate(Eigen::Map<const Matrix>(y.data(), grid_.dim(), grid_.columns()), s);
+  Vector& v = value_;  // kept between re-preparations
+  grid_.evaluate_into(Eigen::Map<const Matrix>(y.data(), grid_.dim(), grid_.columns()), s, v);
   Vector& prepared = prepared_;  // the buffer of the state re-prepared before (swapped out below)
   data_.at(v, s, prepared);
   if (rule_.mode == Repreparation::Mode::Auto) {

@@ -43,6 +43,7 @@ class Repreparer final : public StateObserver {
   Repreparation rule_;
   std::vector<double> times_;
   long last_prepared_ = 0;  // the step of the last preparation
+  Vector value_;            // U(t, t/eps) of the state re-prepared, its storage kept
   Vector prepared_;         // the next prepared state's storage: the state it replaced last time
 };
 

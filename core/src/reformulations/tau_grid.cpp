@@ -104,8 +104,12 @@ bool TauGrid::real_layout_for(const Model& model) {
   return !model.is_complex() && !model.has_linear_remainder();
 }
 
-void TauGrid::set_diagonal(Vector diagonal) {
-  diagonal_ = std::move(diagonal);
+void TauGrid::set_diagonal(const Eigen::Ref<const Vector>& diagonal) {
+  diagonal_ = diagonal;  // into the kept storage
+  bind_diagonal();
+}
+
+void TauGrid::bind_diagonal() {
   grid_field_->set_diagonal(diagonal_);
   for (auto& field : column_fields_) field->set_diagonal(diagonal_);
 }
@@ -113,9 +117,9 @@ void TauGrid::set_diagonal(Vector diagonal) {
 void TauGrid::nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, Real phase) {
   ++*evaluations_;
   if (needs_diagonal_) {
-    Vector diagonal = evaluate(Eigen::Map<const Matrix>(y.data(), dim_, columns_), phase);
-    if (mean_shift) diagonal += *mean_shift;
-    set_diagonal(std::move(diagonal));
+    evaluate_into(Eigen::Map<const Matrix>(y.data(), dim_, columns_), phase, diagonal_);
+    if (mean_shift) diagonal_ += *mean_shift;
+    bind_diagonal();
   }
   if (real_layout_) return nonlinear_real(y, mean_shift, out);
   if (threads_ > 1) return nonlinear_threaded(y, mean_shift, out);
@@ -439,7 +443,13 @@ void TauGrid::evaluate_rows(const Complex* c, Index columns, const std::vector<C
 }
 
 Vector TauGrid::evaluate(ConstMatrixRef c, Real tau) const {
-  Vector value(dim_);
+  Vector value;
+  evaluate_into(c, tau, value);
+  return value;
+}
+
+void TauGrid::evaluate_into(ConstMatrixRef c, Real tau, Vector& value) const {
+  value.resize(dim_);
   const std::vector<Complex> factors = evaluation_factors(c.cols(), tau);
   // By blocks of rows, each summed over the modes in order (the same numbers on any number of
   // threads): a particle state read back every step is 10^7 rows.
@@ -452,7 +462,6 @@ Vector TauGrid::evaluate(ConstMatrixRef c, Real tau) const {
     const Index r0 = b * block;
     evaluate_rows(c.data(), c.cols(), factors, r0, std::min(block, dim_ - r0), value.data() + r0);
   }
-  return value;
 }
 
 }  // namespace tsi

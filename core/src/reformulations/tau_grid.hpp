@@ -83,6 +83,9 @@ class TauGrid {
   /// The trigonometric interpolant of coefficients c at tau (Nyquist split half/half); c holds
   /// all N_tau modes or the real layout's N_tau/2 + 1.
   Vector evaluate(ConstMatrixRef c, Real tau) const;
+  /// The same into out, whose storage is reused when it has dim rows already (a diagonal read
+  /// every stage: 10^7 rows allocated and faulted in again each time otherwise).
+  void evaluate_into(ConstMatrixRef c, Real tau, Vector& out) const;
   /// A = (d/dtau)^{-1} (I - Pi) on coefficients: mode k / (i k), modes 0 and Nyquist to 0.
   Matrix apply_A(Matrix c) const;
   /// A's multiplier on the Fourier index j: 1 / (i k), 0 on modes 0 and Nyquist.
@@ -110,7 +113,9 @@ class TauGrid {
   /// evaluates the field on its columns (between barriers); the same numbers as the serial path.
   void nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out);
   /// Keeps the diagonal value and hands it to every binding (fields that read it only).
-  void set_diagonal(Vector diagonal);
+  void set_diagonal(const Eigen::Ref<const Vector>& diagonal);
+  /// Hands diagonal_ (already set) to every binding.
+  void bind_diagonal();
   /// A field evaluation on threads_ threads: transform_in(p) and transform_out(p) on part p's
   /// rows, evaluate(p, c0, cn) on its columns [c0, c0 + cn), with barriers between; an
   /// exception from evaluate reaches the caller once every thread has finished.
