@@ -151,3 +151,46 @@ TEST_CASE("tau grid threads: tsi --threads records its threads and gives the one
   CHECK(bad.exit_code == 2);
   CHECK(tsi::test::contains(bad.err, "--threads"));
 }
+
+TEST_CASE("tau grid threads: both tau monitors from one pass, by their definitions, alike on two threads") {
+  // Henon-Heiles (real: the real layout, modes 0 .. n/2) and NLS on 2^15 points (complex: all n modes), a
+  // prepared state made rough by hand: tau_roughness is the energy of the modes |k| > 3n/8 over
+  // all of it, tau_spread that of the modes k != 0, the modes -k of the real layout counted
+  // as their conjugates k.
+  auto& h = Harness::instance();
+  for (const char* model : {"henon-heiles", "nls"}) {
+    CAPTURE(model);
+    const auto monitors = [&](int threads) {
+      ThreadSetting setting(threads, 1);
+      tsi::Json m = {{"name", model}, {"eps", 0.1}};
+      if (std::string(model) == "nls") m["n_x"] = 1 << 15;  // 2^15 rows: two of the sums' blocks
+      tsi::Assembly a = h.assemble({{"model", m},
+                                    {"reformulation", {{"name", "two-scale"}, {"n_tau", 16}}},
+                                    {"scheme", {{"name", "se1"}}}});
+      Vector y = a.reformulation->prepare(a.u0);
+      for (Index i = 0; i < y.size(); ++i) y(i) += tsi::Complex(1e-3 * std::sin(0.3 * static_cast<double>(i)), 0.0);
+      const auto* d = a.reformulation->two_scale_diagnostics();
+      REQUIRE(d != nullptr);
+      const tsi::TauProfile p = d->tau_profile(y);
+      CHECK(p.roughness == d->tau_roughness(y));
+      CHECK(p.spread == d->tau_spread(y));
+      const Index dim = a.model->dim(), columns = y.size() / dim;
+      double total = 0.0, top = 0.0, away = 0.0;
+      for (Index j = 0; j < columns; ++j) {
+        const int k = columns == 16 ? static_cast<int>(j < 8 ? j : j - 16) : static_cast<int>(j);  // FFT order
+        const double weight = columns == 9 && j > 0 && j < 8 ? 2.0 : 1.0;
+        const double e = weight * y.segment(j * dim, dim).squaredNorm();
+        total += e;
+        if (8 * std::abs(k) > 3 * 16) top += e;
+        if (j > 0) away += e;
+      }
+      CHECK(p.roughness == doctest::Approx(top / total).epsilon(1e-13));
+      CHECK(p.spread == doctest::Approx(away / total).epsilon(1e-13));
+      CHECK(p.roughness > 1e-8);  // made rough: a value worth comparing
+      return p;
+    };
+    const tsi::TauProfile one = monitors(1), two = monitors(2);
+    CHECK(one.roughness == two.roughness);
+    CHECK(one.spread == two.spread);
+  }
+}

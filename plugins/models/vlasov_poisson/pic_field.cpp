@@ -1,10 +1,12 @@
 #include "pic_field.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
 
 #include "tsi/error.hpp"
+#include "tsi/parallel.hpp"
 #include "tsi/phase.hpp"
 
 namespace tsi::pic {
@@ -184,6 +186,11 @@ Field::Field(const Geometry& geometry, const Collective* collective)
       transforms_(std::make_unique<RealGridTransforms>(grid_, 2)),
       padded_rho_(RealVector::Zero(padded_x_ * padded_y_)),
       padded_e_(RealVector::Zero(2 * padded_x_ * padded_y_)) {
+  // Pieces of at least 2^15 particles, at most 16, and at most 64 MB of their grids.
+  const Index cells = padded_x_ * padded_y_;
+  deposit_parts_ = std::clamp<Index>(g_.particles >> 15, 1, 16);
+  deposit_parts_ = std::max<Index>(1, std::min<Index>(deposit_parts_, (Index(8) << 20) / cells));
+  part_rho_.resize((deposit_parts_ - 1) * cells);
   // Wave numbers of the half spectrum (n_y full, x halved), scaled to the box: E^ = -i k rho^ / |k|^2.
   const Index half = grid_.half_points(), half_x = g_.n_x / 2 + 1;
   k1_.resize(half);
@@ -201,9 +208,16 @@ Field::Field(const Geometry& geometry, const Collective* collective)
 Field::~Field() = default;
 
 void Field::deposit(const Real* base, ParticleLayout layout) {
-  padded_rho_.setZero();
   const Grid grid{inverse_dx_, inverse_dy_, Real(g_.n_x), Real(g_.n_y), Real(padded_x_)};
-  (width_ == 2 ? deposit_cic : deposit_m6)(base, layout, g_.particles, g_.weight(), grid, padded_rho_.data());
+  const Index cells = padded_x_ * padded_y_, parts = deposit_parts_;
+  const auto kernel = width_ == 2 ? deposit_cic : deposit_m6;
+  parallel_for(g_.threads, parts, [&](Index p) {
+    const Index first = g_.particles * p / parts, count = g_.particles * (p + 1) / parts - first;
+    Real* rho = p == 0 ? padded_rho_.data() : part_rho_.data() + (p - 1) * cells;
+    std::fill(rho, rho + cells, Real(0));
+    kernel(base + first * layout.particle_stride, layout, count, g_.weight(), grid, rho);
+  });
+  for (Index p = 1; p < parts; ++p) padded_rho_ += part_rho_.segment((p - 1) * cells, cells);
   // Fold the padding onto the periodic grid: padded (J, I) is node (J - offset, I - offset) mod n.
   auto values = transforms_->values();
   Real* rho = values.col(0).data();

@@ -23,6 +23,7 @@ struct Geometry {
   Shape shape = Shape::m6;
   Index particles = 1;       ///< the particles this process holds
   Index all_particles = 0;   ///< the plasma's, when split over processes (0: the same)
+  int threads = 1;           ///< the run's (its tau-grid threads): the deposition's pieces go on them
 
   Real length_x() const;
   Real length_y() const;
@@ -88,6 +89,11 @@ class Field {
   SpectralGrid grid_;  // (n_y, n_x) in C order: x the last direction, halved by the real transforms
   std::unique_ptr<RealGridTransforms> transforms_;  // 2 columns: rho, then E1 and E2
   RealVector padded_rho_;  // padded_y x padded_x, x fastest
+  // The deposition goes by deposit_parts_ contiguous pieces of the particles, each on its own
+  // padded grid, summed in order: a number fixed by N and the grid, not by the threads, so
+  // the density is the same on any number of them.
+  Index deposit_parts_ = 1;
+  RealVector part_rho_;  // deposit_parts_ - 1 padded grids (piece 0 goes to padded_rho_)
   RealVector padded_e_;    // the same points, (E1, E2) pairs
   bool padded_current_ = false;                    // padded E is the last solve's
   RealVector k1_, k2_, inverse_k2_;  // per point of the half spectrum

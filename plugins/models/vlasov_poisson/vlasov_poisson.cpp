@@ -354,6 +354,7 @@ void register_vlasov_poisson(tsi::Registry& registry) {
           p.string("distribution") == "peer" ? tsi::pic::Distribution::peer : tsi::pic::Distribution::landau;
       particles = tsi::pic::sample_particles(g, distribution, p.number("alpha"), static_cast<std::uint64_t>(p.integer("seed")));
     }
+    g.threads = p.context().tau_grid.threads;
     const TauField tau_field = p.string("tau_field") == "diagonal" ? TauField::diagonal : TauField::per_tau;
     // Split over processes (tsi run --split), this one keeps its contiguous block of particles.
     const tsi::Collective* collective = p.context().collective;

@@ -1,4 +1,5 @@
 #include "tsi/algebra.hpp"
+#include "tsi/parallel.hpp"
 
 #include <algorithm>
 
@@ -27,3 +28,20 @@ void for_ranges(int threads, Index n, FunctionRef<void(Index, Index)> body) {
 }
 
 }  // namespace tsi::algebra::detail
+
+namespace tsi {
+
+void parallel_for(int threads, Index count, FunctionRef<void(Index)> body) {
+  if (threads <= 1 || count <= 1) {
+    for (Index i = 0; i < count; ++i) body(i);
+    return;
+  }
+#if defined(_OPENMP)
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (Index i = 0; i < count; ++i) body(i);
+#else
+  for (Index i = 0; i < count; ++i) body(i);
+#endif
+}
+
+}  // namespace tsi
