@@ -180,13 +180,7 @@ Real Model::rounding_floor(const Vector& u) const {
   return error_norm(to_physical(rounded) - x) / std::max<Real>(error_norm(x), 1e-300);
 }
 
-Vector Model::linear_flow(Real tau, const Vector& u) const {
-  Matrix states = u;
-  RealVector taus(1);
-  taus(0) = tau;
-  linear_flow(taus, states);
-  return states.col(0);
-}
+Vector Model::linear_flow(Real tau, const Vector& u) const { return linear_flow(tau, Vector(u)); }
 
 Vector Model::linear_flow(Real tau, Vector&& u) const {
   RealVector taus(1);
