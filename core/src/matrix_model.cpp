@@ -15,6 +15,7 @@
 #include "tsi/error.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/registry.hpp"
+#include "tsi/time_as_variable.hpp"
 
 namespace tsi {
 
@@ -147,7 +148,9 @@ Matrix PeriodicMatrixFlow::at(Real tau) const {
 
 namespace {
 
-class MatrixModel final : public Model, public FusedTauGrid, public PhysicalVariables {
+// A time-dependent field is the model's TimeDependentField: make_matrix_model hands it to
+// with_time_as_variable, which carries t, and the model itself is of A's size alone.
+class MatrixModel final : public Model, public FusedTauGrid, public TimeDependentField {
  public:
   MatrixModel(Real eps, PeriodicMatrixFlow flow, std::shared_ptr<const Field> field, bool time_dependent,
               bool is_complex, Vector u0, std::string field_name)
@@ -165,35 +168,39 @@ class MatrixModel final : public Model, public FusedTauGrid, public PhysicalVari
       exact_ = AffineExact(flow_.A(), this->eps(), *terms);
   }
 
-  Index dim() const override { return d_ + (time_ ? 1 : 0); }
-  Index physical_dim() const override { return d_; }
+  Index dim() const override { return d_; }
   bool is_complex() const override { return complex_; }
-  // No Hamiltonian structure: f is any field, A any matrix with a 2 pi-periodic e^{A tau}.
-  const FusedTauGrid* fused_tau_grid() const override { return this; }
-  const PhysicalVariables* physical_variables() const override { return this; }
+  // No Hamiltonian structure: f is any field, A any matrix with a 2 pi-periodic e^{A tau}. The
+  // fused tau grid evaluates f at t = 0: an autonomous field's only.
+  const TimeDependentField* time_dependent_field() const override { return time_ ? this : nullptr; }
+  const FusedTauGrid* fused_tau_grid() const override { return time_ ? nullptr : this; }
   double max_linear_frequency() const override { return std::max(1.0, static_cast<double>(flow_.max_frequency())); }
 
   void linear_flow(const RealVector& taus, MatrixRef states) const override {
     for (Index j = 0; j < states.cols(); ++j) {
-      const Vector turned = flow_.at(taus(j)) * states.col(j).head(d_);
-      states.col(j).head(d_) = turned;
+      const Vector turned = flow_.at(taus(j)) * states.col(j);
+      states.col(j) = turned;
     }
   }
 
-  void apply_A(const Vector& u, Vector& out) const override {
-    out = Vector::Zero(dim());
-    out.head(d_) = flow_.A() * u.head(d_);
-  }
+  void apply_A(const Vector& u, Vector& out) const override { out = flow_.A() * u; }
 
   void nonlinear_field(ConstMatrixRef states, MatrixRef out) const override {
-    const RealVector t = times(states);
-    field_->evaluate(t, states.topRows(d_), out.topRows(d_));
-    if (time_) out.row(d_).setOnes();
+    if (time_) return Model::nonlinear_field(states, out);  // refused: f(t, u) is nonlinear_field_at
+    field_->evaluate(RealVector::Zero(states.cols()), states, out);
+  }
+  void nonlinear_field_at(const RealVector& t, ConstMatrixRef states, MatrixRef out) const override {
+    field_->evaluate(t, states, out);
   }
 
   void nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef directions, MatrixRef out) const override {
     if (time_ || !field_->has_derivative()) return Model::nonlinear_field_derivative(states, directions, out);
-    field_->derivative(times(states), states, directions, out);
+    field_->derivative(RealVector::Zero(states.cols()), states, directions, out);
+  }
+  void nonlinear_field_derivative_at(const RealVector& t, ConstMatrixRef states, ConstMatrixRef directions,
+                                     MatrixRef out) const override {
+    if (!field_->has_derivative()) return TimeDependentField::nonlinear_field_derivative_at(t, states, directions, out);
+    field_->derivative(t, states, directions, out);
   }
 
   // f_tau on a fixed tau grid: e^{A tau_j} and e^{-A tau_j} tabulated once per binding.
@@ -213,29 +220,26 @@ class MatrixModel final : public Model, public FusedTauGrid, public PhysicalVari
       }
     }
     void evaluate(MatrixRef states, MatrixRef out) override {
-      const Index d = model_.d_;
       for (Index j = 0; j < states.cols(); ++j) {
         const auto k = static_cast<std::size_t>(j);
         if (tabulated_)
-          turned_.col(j).noalias() = forward_[k] * states.col(j).head(d);
+          turned_.col(j).noalias() = forward_[k] * states.col(j);
         else
-          turned_.col(j) = model_.flow_.at(taus_(j)) * states.col(j).head(d);
-        if (model_.time_) t_(j) = states(d, j).real();
+          turned_.col(j) = model_.flow_.at(taus_(j)) * states.col(j);
       }
       model_.field_->evaluate(t_, turned_, field_);
       for (Index j = 0; j < states.cols(); ++j) {
         const auto k = static_cast<std::size_t>(j);
         if (tabulated_)
-          out.col(j).head(d).noalias() = backward_[k] * field_.col(j);
+          out.col(j).noalias() = backward_[k] * field_.col(j);
         else
-          out.col(j).head(d) = model_.flow_.at(-taus_(j)) * field_.col(j);
+          out.col(j) = model_.flow_.at(-taus_(j)) * field_.col(j);
       }
-      if (model_.time_) out.row(d).setOnes();
     }
 
    private:
     const MatrixModel& model_;
-    RealVector taus_, t_;
+    RealVector taus_, t_;  // t_: 0, an autonomous field's
     Matrix turned_, field_;
     bool tabulated_ = false;
     std::vector<Matrix> forward_, backward_;
@@ -252,25 +256,10 @@ class MatrixModel final : public Model, public FusedTauGrid, public PhysicalVari
       throw ConfigError("model.u0", fmt::format("the field \"{}\" gives no default initial value for this A: give "
                                                 "model.u0 ({} {})",
                                                 field_name_, d_, complex_ ? "numbers or [re, im] pairs" : "numbers"));
-    return from_physical(u0_);
+    return u0_;
   }
-  Vector from_physical(const Vector& x) const override {
-    if (!time_) return x;
-    Vector u = Vector::Zero(d_ + 1);  // t = 0: runs start there
-    u.head(std::min(d_, x.size())) = x.head(std::min(d_, x.size()));
-    return u;
-  }
-  Vector to_physical(const Vector& u) const override { return time_ ? Vector(u.head(d_)) : u; }
 
  private:
-  // The time of every column: its last entry when the model carries t, else 0.
-  RealVector times(ConstMatrixRef states) const {
-    if (!time_) return RealVector::Zero(states.cols());
-    RealVector t(states.cols());  // entry by entry: Eigen's debug aliasing check cannot take a view of a view here
-    for (Index j = 0; j < states.cols(); ++j) t(j) = states(d_, j).real();
-    return t;
-  }
-
   class AffineExact final : public ExactSolution {
    public:
     AffineExact(Matrix A, Real eps, AffineTerms terms) : A_(std::move(A)), eps_(eps), terms_(std::move(terms)) {}
@@ -350,8 +339,8 @@ Json quickstart_A() {
 std::unique_ptr<Model> make_matrix_model(Real eps, PeriodicMatrixFlow flow, std::shared_ptr<const Field> field,
                                          bool time_dependent, bool is_complex, Vector u0, std::string field_name) {
   if (!field) throw Error("make_matrix_model: no field");
-  return std::make_unique<MatrixModel>(eps, std::move(flow), std::move(field), time_dependent, is_complex,
-                                       std::move(u0), std::move(field_name));
+  return with_time_as_variable(std::make_unique<MatrixModel>(eps, std::move(flow), std::move(field), time_dependent,
+                                                             is_complex, std::move(u0), std::move(field_name)));
 }
 
 void register_matrix_model(Registry& registry) {

@@ -4,6 +4,7 @@
 #include <limits>
 #include <string>
 
+#include "central_difference.hpp"
 #include "tsi/error.hpp"
 
 namespace tsi {
@@ -12,28 +13,23 @@ Model::Model(Real eps) : eps_(eps) {
   if (!(eps > 0.0 && eps <= 1.0)) throw ConfigError("model.eps", "expected a number in (0, 1]");
 }
 
+void Model::nonlinear_field(ConstMatrixRef, MatrixRef) const {
+  if (time_dependent_field())
+    throw Error("this model's f depends on t (time_dependent_field()): it is evaluated through "
+                "with_time_as_variable, which carries t, not through Model::nonlinear_field");
+  throw Error("this model gives no field: override Model::nonlinear_field (f(u)) or declare "
+              "time_dependent_field() (f(t, u))");
+}
+
 void Model::nonlinear_field_derivative(ConstMatrixRef states, ConstMatrixRef directions,
                                        MatrixRef out) const {
-  // Central difference with a step balancing truncation (delta^2) and rounding (1/delta).
-  const Real delta = std::cbrt(std::numeric_limits<Real>::epsilon());
-  Matrix plus(states.rows(), states.cols()), minus(states.rows(), states.cols());
-  for (Index j = 0; j < states.cols(); ++j) {
-    const Real scale = std::max<Real>(1, states.col(j).norm()) / std::max<Real>(directions.col(j).norm(), 1e-300);
-    plus.col(j) = states.col(j) + delta * scale * directions.col(j);
-    minus.col(j) = states.col(j) - delta * scale * directions.col(j);
-  }
-  Matrix f_plus(states.rows(), states.cols()), f_minus(states.rows(), states.cols());
-  nonlinear_field(plus, f_plus);
-  nonlinear_field(minus, f_minus);
-  for (Index j = 0; j < states.cols(); ++j) {
-    const Real dn = directions.col(j).norm();
-    if (dn == 0.0) {
-      out.col(j).setZero();
-      continue;
-    }
-    const Real scale = std::max<Real>(1, states.col(j).norm()) / dn;
-    out.col(j) = (f_plus.col(j) - f_minus.col(j)) / (2.0 * delta * scale);
-  }
+  central_difference([this](ConstMatrixRef u, MatrixRef f) { nonlinear_field(u, f); }, states, directions, out);
+}
+
+void TimeDependentField::nonlinear_field_derivative_at(const RealVector& t, ConstMatrixRef states,
+                                                       ConstMatrixRef directions, MatrixRef out) const {
+  central_difference([this, &t](ConstMatrixRef u, MatrixRef f) { nonlinear_field_at(t, u, f); }, states, directions,
+                     out);
 }
 
 void Model::filtered_field(const RealVector& taus, MatrixRef states, MatrixRef out) const {

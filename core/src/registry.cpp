@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "tsi/error.hpp"
+#include "tsi/time_as_variable.hpp"
 
 namespace tsi {
 
@@ -118,6 +119,10 @@ void Registry::add_model(ModelEntry entry) {
             .check([](const Json&) { return true; },
                    "an array of numbers (complex ones as [re, im]) or the name of a .npy file"));
   }
+  // A model with a time-dependent f is created carrying t (time_as_variable.hpp): whoever
+  // creates it (a run, `tsi check`, Python) gets the model every scheme integrates.
+  if (entry.create)
+    entry.create = [create = std::move(entry.create)](const Params& p) { return with_time_as_variable(create(p)); };
   impl_->models.add(std::move(entry), impl_->provider);
 }
 

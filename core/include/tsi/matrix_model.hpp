@@ -51,10 +51,11 @@ class TSI_API PeriodicMatrixFlow {
 };
 
 /// The general-class model u' = (1/eps) A u + f(t, u) with A a matrix and f a field: e^{A tau}
-/// from PeriodicMatrixFlow, f from `field`. With `time_dependent`, the state carries t as one
-/// more variable (t' = 1, A padded with a zero row and column, as HOODESolver.jl does): dim()
-/// is A's size + 1, physical variables (u0, u_final, errors) are u without t, and runs start
-/// at t = 0. `u0` (physical, may be empty) is the default initial value.
+/// from PeriodicMatrixFlow, f from `field`. With `time_dependent`, the model declares its field
+/// as a TimeDependentField and is returned through with_time_as_variable (time_as_variable.hpp),
+/// which carries t as one more variable (t' = 1, A padded with a zero row and column, as
+/// HOODESolver.jl does): dim() is A's size + 1, physical variables (u0, u_final, errors) are u
+/// without t, and runs start at t = 0. `u0` (physical, may be empty) is the default initial value.
 TSI_API std::unique_ptr<Model> make_matrix_model(Real eps, PeriodicMatrixFlow flow,
                                                  std::shared_ptr<const Field> field, bool time_dependent,
                                                  bool is_complex, Vector u0, std::string field_name);

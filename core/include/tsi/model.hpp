@@ -11,12 +11,17 @@
 namespace tsi {
 
 /// The general class u' = (1/eps) A u + R u + f(t, u) (SPEC.md section 7). A model gives a
-/// small required core: its size, the action of e^{A tau} (2 pi-periodic) and f, on batches
-/// (one state per column, so that the two-scale reformulation evaluates all tau points in one
-/// call), and its initial value. R (default: none) is a linear part bounded in eps but possibly
-/// large (a spatial operator), handed over so that every reformulation and scheme integrates
-/// it exactly instead of through f (linear_remainder). A time-dependent f is carried as one
-/// more variable (the matrix model does so).
+/// small required core: its size, whether it is complex, the action of e^{A tau}
+/// (2 pi-periodic) and f, on batches (one state per column, so that the two-scale
+/// reformulation evaluates all tau points in one call), and its initial value. R (default:
+/// none) is a linear part bounded in eps but possibly large (a spatial operator), handed over
+/// so that every reformulation and scheme integrates it exactly instead of through f
+/// (linear_remainder).
+///
+/// f is nonlinear_field(u) for an autonomous f. A time-dependent f(t, u) is the declared
+/// capability TimeDependentField instead (time_dependent_field()): the core then carries t as
+/// one more variable (with_time_as_variable, applied where a registered model is created), so
+/// that every reformulation and scheme integrates it and none sees the difference.
 ///
 /// Everything else is a declared capability (model_capabilities.hpp), as StepperTraits are for
 /// schemes: the Hamiltonian structure of the paper's class (A = J M, f = J grad H1: energies),
@@ -41,8 +46,10 @@ class TSI_API Model {
   virtual bool is_complex() const = 0;
   /// The exact linear flow e^{A tau}, applied in place to column j with phase taus[j].
   virtual void linear_flow(const RealVector& taus, MatrixRef states) const = 0;
-  /// f(u) for every column u of `states` (J grad H1(u) in the Hamiltonian class).
-  virtual void nonlinear_field(ConstMatrixRef states, MatrixRef out) const = 0;
+  /// f(u) for every column u of `states` (J grad H1(u) in the Hamiltonian class). Required of
+  /// every model but one that declares time_dependent_field(), which gives f(t, u) there; the
+  /// default throws, naming both.
+  virtual void nonlinear_field(ConstMatrixRef states, MatrixRef out) const;
   /// The model's default initial value u0 (model variables).
   virtual Vector initial_value() const = 0;
 
@@ -79,6 +86,8 @@ class TSI_API Model {
 
   // ---- Declared capabilities (model_capabilities.hpp): null where the model has none -----
 
+  /// f(t, u), a field that depends on time, in place of nonlinear_field (the core carries t).
+  virtual const TimeDependentField* time_dependent_field() const { return nullptr; }
   /// The Hamiltonian structure (J, M, H1): energies and their checks.
   virtual const HamiltonianStructure* hamiltonian() const { return nullptr; }
   /// f_tau in one pass and bound to a tau grid (else flow, field and flow back).
@@ -92,6 +101,7 @@ class TSI_API Model {
 
   // ---- What the rest of tsi uses, built on the above (not virtual) -----------------------
 
+  bool has_time_dependent_field() const { return time_dependent_field() != nullptr; }
   bool has_hamiltonian_structure() const { return hamiltonian() != nullptr; }
   bool has_exact_nonlinear_flow() const { return exact_nonlinear_flow() != nullptr; }
   bool has_linear_remainder() const { return linear_remainder().size() > 0; }

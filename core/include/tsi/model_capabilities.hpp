@@ -1,10 +1,10 @@
 #pragma once
 // What a model may declare beyond the required core of tsi::Model (model.hpp). Each is an
 // interface a model implements (usually by inheriting it) and hands out from its getter on
-// Model (hamiltonian(), fused_tau_grid(), exact_nonlinear_flow(), physical_variables(),
-// exact_solution()); a null getter means the model does not have it, and the parts of tsi
-// that need it say so (a splitting scheme needs the exact nonlinear flow, energies need the
-// Hamiltonian structure, `tsi check` skips what a model does not declare).
+// Model (time_dependent_field(), hamiltonian(), fused_tau_grid(), exact_nonlinear_flow(),
+// physical_variables(), exact_solution()); a null getter means the model does not have it,
+// and the parts of tsi that need it say so (a splitting scheme needs the exact nonlinear flow,
+// energies need the Hamiltonian structure, `tsi check` skips what a model does not declare).
 #include <functional>
 #include <memory>
 #include <vector>
@@ -14,6 +14,27 @@
 #include "tsi/types.hpp"
 
 namespace tsi {
+
+/// A field f(t, u) that depends on time, the general class's u' = (1/eps) A u + f(t, u): a model
+/// that declares it gives f here, and tsi carries t as one more variable (t' = 1, untouched by
+/// e^{A tau}: HOODESolver.jl's way, SPEC.md section 7) where the model is created
+/// (with_time_as_variable, time_as_variable.hpp), so that every reformulation and scheme
+/// integrates it. Its initial value, physical variables, u_final, errors, invariants and exact
+/// solution stay the model's own, without t; runs start at t = 0. Such a model need not override
+/// Model::nonlinear_field, and declares no capability that takes no t (hamiltonian(),
+/// fused_tau_grid(), exact_nonlinear_flow(): refused when the model is created).
+class TSI_API TimeDependentField {
+ public:
+  virtual ~TimeDependentField() = default;
+  /// out.col(j) = f(t(j), states.col(j)) for every column, each state with its own time (a
+  /// batch may hold states of different times). `out` has the shape of `states`, is not
+  /// zeroed and never aliases it.
+  virtual void nonlinear_field_at(const RealVector& t, ConstMatrixRef states, MatrixRef out) const = 0;
+  /// out.col(j) = D_u f(t(j), u_j) z_j, the derivative in u at fixed time (tsi adds the
+  /// derivative in t itself). The default is a central difference in u; a closed form is better.
+  virtual void nonlinear_field_derivative_at(const RealVector& t, ConstMatrixRef states, ConstMatrixRef directions,
+                                             MatrixRef out) const;
+};
 
 /// f_tau over one fixed set of phases (a run's tau grid), bound once per run by
 /// FusedTauGrid::bind_tau_grid: what the model precomputes for those phases (rotation tables,
