@@ -46,9 +46,17 @@
 // In 2-D and 3-D the products over the directions: z(x, 0) = prod_i cos x_i / (1 + sin^2 x_i),
 // and the momentum part (1/2) prod_i sin x_i / (1 + cos^2 x_i). `initial: "plane-wave"` gives
 // v0 = a e^{i k.x} instead, an exact solution at lambda = 0 (v0 e^{i omega_k t}).
+//
+// The literature's data (model.z0, model.eps_z_t0): z(x, 0) and p(x, 0) = e^2 z_t(x, 0) on the grid,
+// real, instead of v in model.u0; the model forms c = sqrt(2 pi) (a_k q_k - i p_k / a_k) itself.
+// "eps z_t(0)" of Chartier, Crouseilles, Lemou, Mehats is this p: their eps is tsi's, e^2. Their
+// z is complex; this model's is real, so a complex sample is refused, never cut to its real part
+// (which would solve another problem without a word).
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <complex>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <limits>
@@ -73,6 +81,12 @@ using tsi::MatrixRef;
 using tsi::Vector;
 
 
+/// z(x, 0) and p(x, 0) = e^2 z_t(x, 0) on the grid, in its C order: initial data in the
+/// literature's form (model.z0, model.eps_z_t0).
+struct FieldAndMomentum {
+  tsi::RealVector z, p;
+};
+
 /// cos and sin of a set of phases.
 struct Phases {
   Phases() = default;
@@ -88,13 +102,15 @@ class KleinGordon final : public tsi::Model,
                           public tsi::ExactSolution {
  public:
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
-  // wave: the plane wave of model.initial = "plane-wave", else none (the default data).
+  // wave: the plane wave of model.initial = "plane-wave"; data: z and e^2 z_t of model.z0 and
+  // model.eps_z_t0; neither: the default data.
   KleinGordon(Real eps, std::vector<int> shape, Real lambda, std::optional<tsi::PlaneWave> wave,
-              tsi::ThreadLimit fftw_threads = {})
+              std::optional<FieldAndMomentum> data, tsi::ThreadLimit fftw_threads = {})
       : Model(eps),
         grid_(std::move(shape)),
         n_x_(grid_.points()),
         wave_(wave),
+        data_(std::move(data)),
         lambda_(lambda),
         volume_(std::pow(tsi::two_pi, grid_.dims())),
         inverse_a_(n_x_),
@@ -229,8 +245,10 @@ class KleinGordon final : public tsi::Model,
     c += t * field;
   }
 
-  // v0(x) = cos x / (1 + sin^2 x) - (i/2) sin x / (1 + cos^2 x) (see the header).
+  // v0(x) = cos x / (1 + sin^2 x) - (i/2) sin x / (1 + cos^2 x) (see the header), or the state
+  // of model.z0 and model.eps_z_t0.
   Vector initial_value() const override {
+    if (data_) return from_field_and_momentum(*data_);
     Vector v(n_x_);
     grid_.for_each_point([&](Index j, const std::array<Real, 3>& x) {
       if (wave_) {
@@ -275,6 +293,22 @@ class KleinGordon final : public tsi::Model,
     w.col(0) = v;
     b.forward();
     return (std::sqrt(volume_) / point_count()) * w.col(0).cwiseQuotient(inverse_a_.cast<Complex>());
+  }
+
+  // (q, p) on the grid -> c = sqrt(2 pi) / n_x * (a forward(q) - i a^{-1} forward(p)) (the header's
+  // Q - i P), which is from_physical(q - i (1 - e^2 d_xx)^{-1/2} p).
+  Vector from_field_and_momentum(const FieldAndMomentum& data) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    tsi::GridTransforms& b = batch(1);
+    auto w = b.data();
+    w.col(0) = data.z.cast<Complex>();
+    b.forward();
+    const Vector q_hat = w.col(0);
+    w.col(0) = data.p.cast<Complex>();
+    b.forward();
+    const Vector c = q_hat.cwiseQuotient(inverse_a_.cast<Complex>()) -
+                     Complex(0.0, 1.0) * w.col(0).cwiseProduct(inverse_a_.cast<Complex>());
+    return (std::sqrt(volume_) / point_count()) * c;
   }
 
   // c -> v = backward(a^{-1} c) / sqrt(2 pi).
@@ -338,6 +372,7 @@ class KleinGordon final : public tsi::Model,
   tsi::SpectralGrid grid_;
   Index n_x_;       // the grid's points, N
   std::optional<tsi::PlaneWave> wave_;
+  std::optional<FieldAndMomentum> data_;  // model.z0 and model.eps_z_t0
   Real lambda_;
   Real volume_;   // (2 pi)^d
   tsi::RealVector inverse_a_;  // a_k^{-1} = (1 + eps k^2)^{-1/4}
@@ -350,6 +385,68 @@ class KleinGordon final : public tsi::Model,
   mutable std::map<Index, std::unique_ptr<tsi::RealGridTransforms>> real_batches_;  // real: z and the field
 };
 
+// A JSON value as a message shows it, cut to 60 characters.
+std::string shown(const tsi::Json& v) {
+  const std::string s = v.dump();
+  return s.size() > 60 ? s.substr(0, 57) + "..." : s;
+}
+
+// A JSON number that is finite, as x.
+bool finite_number(const tsi::Json& v, Real& x) {
+  if (!v.is_number()) return false;
+  x = v.get<Real>();
+  return std::isfinite(x);
+}
+
+// model.z0 or model.eps_z_t0: one real number per grid point, in the grid's C order as model.u0
+// ([re, 0] is taken as re). A complex sample is refused, naming it: reading its real part would
+// solve another problem without a word.
+tsi::RealVector real_samples(const tsi::Json& value, const std::string& field, const tsi::SpectralGrid& grid) {
+  const auto points = static_cast<std::size_t>(grid.points());
+  const std::string expected = std::to_string(points) + " real numbers, one per grid point (the grid " +
+                               grid.describe() + ") in C order (the last direction fastest), as model.u0";
+  if (!value.is_array()) throw tsi::ConfigError(field, "got " + shown(value) + ", expected " + expected);
+  if (value.size() != points)
+    throw tsi::ConfigError(field, "got " + std::to_string(value.size()) + " samples, expected " + expected);
+  tsi::RealVector samples(grid.points());
+  for (std::size_t j = 0; j < points; ++j) {
+    const tsi::Json& v = value[j];
+    const std::string entry = field + "[" + std::to_string(j) + "]";
+    Real re = 0.0, im = 0.0;
+    const bool ok = finite_number(v, re) ||
+                    (v.is_array() && v.size() == 2 && finite_number(v[0], re) && finite_number(v[1], im));
+    if (!ok) throw tsi::ConfigError(entry, "got " + shown(v) + ", expected a finite real number");
+    if (im != 0.0)
+      throw tsi::ConfigError(entry, "got " + shown(v) +
+                                        ", expected a real number: this model's z is real; complex z (Chartier, "
+                                        "Crouseilles, Lemou, Mehats) needs a complex Klein-Gordon model, which this "
+                                        "one is not");
+    samples(static_cast<Index>(j)) = re;
+  }
+  return samples;
+}
+
+// The initial data of model.z0 and model.eps_z_t0 (either may be left out: zero), or none where
+// neither is given. They replace the default data; model.u0 (v itself) and the plane wave are
+// other data, refused beside them.
+std::optional<FieldAndMomentum> field_and_momentum(const tsi::Params& p, const std::vector<int>& shape) {
+  const char* names[2] = {"z0", "eps_z_t0"};
+  const char* const* given = std::find_if(std::begin(names), std::end(names), [&](const char* n) { return p.has(n); });
+  if (given == std::end(names)) return std::nullopt;
+  const std::string field = std::string("model.") + *given;
+  if (p.has("u0"))
+    throw tsi::ConfigError(field, "is given together with model.u0, which is the physical variable v = z - i (1 - "
+                                  "e^2 d_xx)^{-1/2} (e^2 z_t) itself: give either u0 or z0 and eps_z_t0, not both");
+  if (p.string("initial") == "plane-wave")
+    throw tsi::ConfigError(field, "is given, but model.initial is \"plane-wave\": z0 and eps_z_t0 replace the "
+                                  "default data, not the plane wave; give one or the other");
+  const tsi::SpectralGrid grid(shape);
+  FieldAndMomentum data{tsi::RealVector::Zero(grid.points()), tsi::RealVector::Zero(grid.points())};
+  if (p.has("z0")) data.z = real_samples(p.raw().at("z0"), "model.z0", grid);
+  if (p.has("eps_z_t0")) data.p = real_samples(p.raw().at("eps_z_t0"), "model.eps_z_t0", grid);
+  return data;
+}
+
 void register_klein_gordon(tsi::Registry& registry) {
   tsi::ModelEntry entry;
   entry.info.name = "klein-gordon";
@@ -357,10 +454,30 @@ void register_klein_gordon(tsi::Registry& registry) {
   entry.info.summary =
       "nonlinear Klein-Gordon e^2 z_tt - lap z + z/e^2 + lambda z^3 = 0 on the torus [0, 2 pi)^dims, eps = e^2, "
       "Fourier in space, dim n_x [n_y [n_z]]";
-  entry.info.params = tsi::spectral_grid_params("samples of v");
+  entry.info.params = tsi::spectral_grid_params("samples of v, not of z,");
   for (tsi::ParamSpec& spec : tsi::initial_data_params(
            "default", "z = cos x / (1 + sin^2 x) and its momentum, products over the directions"))
     entry.info.params.push_back(std::move(spec));
+  // u0 is the registry's common parameter, documented here for what it is in this model: v, not z.
+  const auto any = [](const tsi::Json&) { return true; };
+  entry.info.params.push_back(
+      tsi::array_param("u0",
+                       "initial value in physical variables: samples of v = z - i (1 - e^2 d_xx)^{-1/2} (e^2 z_t) on "
+                       "the grid, NOT of z (for z and e^2 z_t give model.z0 and model.eps_z_t0); default: the "
+                       "model's own")
+          .check(any, "an array of numbers (complex ones as [re, im]) or the name of a .npy file"));
+  entry.info.params.push_back(
+      tsi::array_param("z0",
+                       "initial data in the literature's form, instead of u0: z(x, 0), one real number per grid "
+                       "point in C order (as u0); default 0 where eps_z_t0 is given. z is real here: a complex "
+                       "sample is refused")
+          .check(any, "an array of real numbers, one per grid point"));
+  entry.info.params.push_back(
+      tsi::array_param("eps_z_t0",
+                       "initial data in the literature's form, with z0: eps z_t(x, 0) = e^2 z_t(x, 0), the momentum, "
+                       "not z_t itself (tsi's eps is e^2, as in Chartier-Crouseilles-Lemou-Mehats' \"eps "
+                       "z_t(0)\"), one real number per grid point in C order; default 0")
+          .check(any, "an array of real numbers, one per grid point"));
   entry.info.params.push_back(
       tsi::number_param("lambda", 1.0, "coefficient of the cubic term lambda z^3")
           .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number"));
@@ -374,8 +491,10 @@ void register_klein_gordon(tsi::Registry& registry) {
   entry.verification = {{1.0, 1.0 / 256, 1e-4, 1e-6}, {16, 32, 64, 128}};
   entry.create = [](const tsi::Params& p) {
     std::vector<int> shape = tsi::spectral_grid_shape(p);
+    std::optional<FieldAndMomentum> data = field_and_momentum(p, shape);
     const std::optional<tsi::PlaneWave> wave = tsi::plane_wave(p, shape);
-    return std::make_unique<KleinGordon>(p.number("eps"), std::move(shape), p.number("lambda"), wave, p.context().fft);
+    return std::make_unique<KleinGordon>(p.number("eps"), std::move(shape), p.number("lambda"), wave, std::move(data),
+                                         p.context().fft);
   };
   registry.add_model(std::move(entry));
 }
