@@ -5,6 +5,7 @@
 #   P/include/tsi/*.hpp          the public headers: everything a plugin needs
 #   P/lib/cmake/tsi/             the CMake package: find_package(tsi CONFIG), tsi::core,
 #                                tsi::tsi (the runner) and tsi_add_plugin()
+#   P/share/tsi/examples/plugins/ the example plugins, each buildable against P
 # RPATHs are $ORIGIN-relative, so nothing needs LD_LIBRARY_PATH.
 include(CMakePackageConfigHelpers)
 
@@ -32,6 +33,12 @@ install(FILES ${PROJECT_BINARY_DIR}/cmake/tsiConfig.cmake ${PROJECT_BINARY_DIR}/
 
 # The plotting script `tsi study` calls, found next to an installed runner (share/tsi).
 install(FILES ${PROJECT_SOURCE_DIR}/scripts/plot_study.py DESTINATION ${CMAKE_INSTALL_DATADIR}/tsi OPTIONAL)
+# The example plugins, each a CMake project of its own that builds against this prefix
+# (find_package(tsi)): a model of the general class (van_der_pol), a Hamiltonian model (fput)
+# and a scheme (expmid). tests/sdk builds and runs every one from here. A build directory
+# left in the source tree stays out.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/plugins/ DESTINATION ${CMAKE_INSTALL_DATADIR}/tsi/examples/plugins
+        REGEX "/build[^/]*$" EXCLUDE)
 # The documents a plugin author works from, next to the headers they describe: the formulas
 # and numbers (SPEC.md), writing a model or a scheme, and the plugin ABI.
 install(FILES ${PROJECT_SOURCE_DIR}/docs/SPEC.md ${PROJECT_SOURCE_DIR}/docs/writing-a-model.md

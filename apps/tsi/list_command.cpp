@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <filesystem>
+
 #include "tsi/error.hpp"
 
 namespace tsi::app {
@@ -18,11 +21,24 @@ Json params_json(const ParamSchema& schema) {
   return out;
 }
 
-Json info_json(const EntryInfo& info) {
+/// The providers the given plugin files stand for: the loader stamps an entry with its file's
+/// canonical path, whatever path --plugin named it by.
+std::vector<std::string> canonical_providers(const std::vector<std::string>& files) {
+  std::vector<std::string> out;
+  for (const auto& file : files) {
+    std::error_code ec;
+    const auto canonical = std::filesystem::canonical(file, ec);
+    out.push_back(ec ? file : canonical.string());
+  }
+  return out;
+}
+
+Json info_json(const EntryInfo& info, const std::vector<std::string>& marked) {
   return {{"name", info.name},
           {"aliases", info.aliases},
           {"summary", info.summary},
           {"provider", info.provider},
+          {"from_plugin_option", std::find(marked.begin(), marked.end(), info.provider) != marked.end()},
           {"params", params_json(info.params)}};
 }
 
@@ -33,13 +49,14 @@ void check_what(const std::string& what) {
 
 }  // namespace
 
-Json list_json(const Registry& registry, const std::string& what) {
+Json list_json(const Registry& registry, const std::string& what, const std::vector<std::string>& given_plugins) {
   check_what(what);
+  const std::vector<std::string> marked = canonical_providers(given_plugins);
   Json out = Json::object();
   if (what.empty() || what == "models") {
     out["models"] = Json::array();
     for (const auto* e : registry.models()) {
-      Json j = info_json(e->info);
+      Json j = info_json(e->info, marked);
       j["default_n_tau"] = e->default_n_tau;
       j["linear_remainder"] = e->linear_remainder;
       out["models"].push_back(j);
@@ -47,12 +64,12 @@ Json list_json(const Registry& registry, const std::string& what) {
   }
   if (what.empty() || what == "reformulations") {
     out["reformulations"] = Json::array();
-    for (const auto* e : registry.reformulations()) out["reformulations"].push_back(info_json(e->info));
+    for (const auto* e : registry.reformulations()) out["reformulations"].push_back(info_json(e->info, marked));
   }
   if (what.empty() || what == "schemes") {
     out["schemes"] = Json::array();
     for (const auto* e : registry.schemes()) {
-      Json j = info_json(e->info);
+      Json j = info_json(e->info, marked);
       const StepperTraits t = default_traits(*e);  // with its default parameters
       j["traits"] = {{"order", t.order},         {"classical_order", std::max(t.order, t.classical_order)},
                      {"resonant_order", t.order_with_resonances()},
@@ -67,7 +84,7 @@ Json list_json(const Registry& registry, const std::string& what) {
   if (what.empty() || what == "fields") {
     out["fields"] = Json::array();
     for (const auto* e : registry.fields()) {
-      Json j = info_json(e->info);
+      Json j = info_json(e->info, marked);
       j["dim"] = e->dim;
       j["time_dependent"] = e->time_dependent;
       j["is_complex"] = e->is_complex;
@@ -77,8 +94,8 @@ Json list_json(const Registry& registry, const std::string& what) {
   return out;
 }
 
-std::string list_text(const Registry& registry, const std::string& what) {
-  const Json all = list_json(registry, what);
+std::string list_text(const Registry& registry, const std::string& what, const std::vector<std::string>& given_plugins) {
+  const Json all = list_json(registry, what, given_plugins);
   std::string s;
   for (const char* kind : {"models", "reformulations", "schemes", "fields"}) {
     if (!all.contains(kind)) continue;
@@ -86,8 +103,12 @@ std::string list_text(const Registry& registry, const std::string& what) {
     for (const auto& e : all[kind]) {
       std::string aliases;
       for (const auto& a : e["aliases"]) aliases += (aliases.empty() ? "" : ", ") + a.get<std::string>();
-      s += fmt::format("  {}{}  {}\n", e["name"].get<std::string>(),
-                       aliases.empty() ? "" : " (" + aliases + ")", e["summary"].get<std::string>());
+      const std::string mark =
+          e["from_plugin_option"].get<bool>()
+              ? "  [from " + std::filesystem::path(e["provider"].get<std::string>()).filename().string() + "]"
+              : "";
+      s += fmt::format("  {}{}  {}{}\n", e["name"].get<std::string>(),
+                       aliases.empty() ? "" : " (" + aliases + ")", e["summary"].get<std::string>(), mark);
       if (e.contains("traits")) {
         const auto& t = e["traits"];
         std::string reforms;

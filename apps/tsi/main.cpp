@@ -1,7 +1,8 @@
 // tsi: the runner. Wires model, reformulation and scheme together from a JSON config.
-//   tsi list [models|reformulations|schemes] [--json]
-//   tsi run CONFIG.json [--out DIR] [--set key.path=value ...] [--max-steps N]
-//   tsi study STUDY.json [--out DIR] [--jobs N] [--shard i/N] [--max-steps N] [--resume | --force]; tsi study --merge DIR... --out DIR
+//   tsi list [models|reformulations|schemes|fields] [--json]   (entries of --plugin FILE marked)
+//   tsi run CONFIG.json [--out DIR] [--set key.path=value ...] [--max-steps N] [--dry-run] [--quiet]
+//   tsi study STUDY.json [--out DIR] [--jobs N] [--shard i/N] [--max-steps N] [--resume | --force] [--dry-run] [--quiet]
+//   tsi study --merge DIR... --out DIR;  -h: short help, --help: long help
 // Exit codes: 0 success, 1 a run failed (its files are still written), 2 bad input, 3 an output
 // could not be written (what could be is kept valid), 128 + N interrupted by signal N.
 #include <fmt/format.h>
@@ -19,8 +20,11 @@
 #include "check_command.hpp"
 #include "interrupt.hpp"
 #include "config.hpp"
+#include "dry_run.hpp"
+#include "help_text.hpp"
 #include "list_command.hpp"
 #include "plugin_setup.hpp"
+#include "progress.hpp"
 #include "run.hpp"
 #include "run_files.hpp"
 #include "split_processes.hpp"
@@ -37,7 +41,8 @@ namespace {
 using tsi::Json;
 
 int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::string& config_path,
-                std::string out_dir, const std::vector<std::string>& overrides, const tsi::app::RunSettings& settings) {
+                std::string out_dir, const std::vector<std::string>& overrides, const tsi::app::RunSettings& settings,
+                bool dry_run, bool quiet) {
   Json raw = tsi::app::load_config_file(config_path);
   for (const auto& assignment : overrides) tsi::app::apply_override(raw, assignment);
   tsi::app::resolve_config_files(raw, config_path);  // model.u0 as a file: relative to the config, as plugins
@@ -48,6 +53,7 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
   // own objects are checked (their memory first), still before anything is computed.
   tsi::app::check_run_steps(config, settings.max_steps);
   if (out_dir.empty()) out_dir = "out/" + std::filesystem::path(config_path).stem().string();
+  if (dry_run) return tsi::app::run_dry_run(config_path, config, registry, settings, out_dir);  // writes nothing
   const tsi::Collective* split = settings.context.collective;
   const bool writer = !split || split->rank() == 0;  // a split run's files are rank 0's
   if (split) {
@@ -56,25 +62,13 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
     tsi::app::prepare_output_dir(out_dir);
   }
 
-  const bool tty = writer && isatty(fileno(stderr));
-  auto phase_started = std::chrono::steady_clock::now();
-  std::string phase;
-  auto progress = [&](double fraction, const char* what) {
-    if (!tty) return;
-    if (phase != what) {  // each phase (run, reference, its check) has its own estimate
-      phase = what;
-      phase_started = std::chrono::steady_clock::now();
-    }
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - phase_started).count();
-    if (fraction > 0.0)  // a run of hours says so within its first seconds
-      fmt::print(stderr, "\r  {}: {:5.1f}%, {:.0f} s elapsed, about {:.0f} s to go   ", what, 100.0 * fraction,
-                 elapsed, elapsed * (1.0 - fraction) / fraction);
-    else
-      fmt::print(stderr, "\r  {}: {:5.1f}%", what, 100.0 * fraction);
-  };
+  // The progress line: rank 0's only; erased before the summary (and before an error).
+  tsi::app::ProgressLine line(writer ? tsi::app::stderr_progress_mode(quiet) : tsi::app::ProgressMode::off);
+  tsi::app::StepProgressLine progress(line);
   const tsi::app::RunOutcome outcome =
-      tsi::app::execute_run(config, registry, settings, progress, nullptr, writer ? out_dir : std::string());
-  if (tty) fmt::print(stderr, "\r{:80}\r", "");
+      tsi::app::execute_run(config, registry, settings, line.enabled() ? tsi::app::ProgressFn(std::ref(progress)) : nullptr,
+                            nullptr, writer ? out_dir : std::string());
+  line.finish();
   if (!writer) return outcome.ok ? 0 : 1;  // the same status on every rank: its stops are agreed
   tsi::app::write_run_files(out_dir, outcome);  // IoError (exit 3) when result.json cannot be written
   fmt::print("{}", tsi::app::run_summary(outcome, out_dir));
@@ -101,6 +95,10 @@ int main(int argc, char** argv) {
     return "tsi: error: " + std::string(e.what()) + "\nRun with --help for more information.\n";
   });
   app.require_subcommand(1);
+  // -h the short help (the options), --help the long one (with exit codes and examples); both on
+  // stdout. Set before the subcommands, which take them over.
+  app.set_help_flag("-h", "print the short help (the options) and exit");
+  app.set_help_all_flag("--help", "print the long help (what is written, exit codes, examples) and exit");
   app.set_version_flag("--version", tsi::version_string);
   std::vector<std::string> plugin_files;
   app.add_option("--plugin", plugin_files, "load a plugin library (repeatable)")->check(CLI::ExistingFile);
@@ -117,7 +115,7 @@ int main(int argc, char** argv) {
                  "already share the cores)")
       ->check(CLI::Range(1, 1024));
 
-  auto* list = app.add_subcommand("list", "list registered models, reformulations, schemes and fields");
+  auto* list = app.add_subcommand("list", "list registered models, reformulations, schemes and fields (those of --plugin FILE marked)");
   std::string what;
   bool as_json = false;
   list->add_option("what", what, "models, reformulations, schemes or fields (default: all)");
@@ -133,6 +131,10 @@ int main(int argc, char** argv) {
   const std::string max_steps_help =
       "refuse a run (or its reference) estimated to take more than N steps, before it starts (default 1e9)";
   run->add_option("--max-steps", max_steps, max_steps_help);
+  bool dry_run = false, quiet = false;
+  run->add_flag("--dry-run", dry_run, "check the config as a run would and print its steps, memory and reference; "
+                                      "run and write nothing");
+  run->add_flag("--quiet,-q", quiet, "no progress line");
   bool split = false;
   run->add_flag("--split", split,
                 "split the run's state over MPI ranks: mpirun -np P tsi run CONFIG --split (vlasov-poisson-2d's "
@@ -157,6 +159,9 @@ int main(int argc, char** argv) {
   bool resume = false, force = false;
   study->add_flag("--resume", resume, "keep the runs of this study that finished in --out (an interrupted study), run the rest");
   study->add_flag("--force", force, "replace the results of another study in --out instead of refusing");
+  study->add_flag("--dry-run", dry_run, "check every run as it would run and print their steps, memory and "
+                                        "references; run and write nothing");
+  study->add_flag("--quiet,-q", quiet, "no progress line");
 
   // tsi check [MODEL] [--plugin FILE] [--scheme NAME] [--eps EPS] (check_command.hpp)
   auto* check = app.add_subcommand("check", "run the conformance checks on a model or plugin");
@@ -180,6 +185,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    if (dynamic_cast<const CLI::CallForAllHelp*>(&e)) {  // --help: what -h leaves out, after the options
+      app.footer(tsi::app::long_help(""));
+      for (auto* sub : app.get_subcommands([](CLI::App*) { return true; })) sub->footer(tsi::app::long_help(sub->get_name()));
+    }
     return app.exit(e) == 0 ? 0 : 2;
   }
   // A run or study stops at its next step on SIGINT or SIGTERM and writes what it has; the
@@ -210,8 +219,9 @@ int main(int argc, char** argv) {
     for (const auto& warning : tsi::app::load_plugins(loader, registry, plugin_files))
       spdlog::warn("plugin not loaded: {}", warning);
     if (list->parsed()) {
-      fmt::print("{}", as_json ? tsi::app::list_json(registry, what).dump(2) + "\n"
-                               : tsi::app::list_text(registry, what));
+      // the entries of the --plugin files are marked: what a plugin added, at a glance
+      fmt::print("{}", as_json ? tsi::app::list_json(registry, what, plugin_files).dump(2) + "\n"
+                               : tsi::app::list_text(registry, what, plugin_files));
       return 0;
     }
     if (check->parsed()) {
@@ -234,8 +244,8 @@ int main(int argc, char** argv) {
     const int rc = study->parsed()
                        ? tsi::app::study_entry(loader, registry,
                                                {study_path, study_out, jobs, study_overrides, !no_plots, shard, merge_dirs, resume, force,
-                                                settings})
-                       : run_command(loader, registry, config_path, out_dir, overrides, settings);
+                                                settings, dry_run, quiet})
+                       : run_command(loader, registry, config_path, out_dir, overrides, settings, dry_run, quiet);
     if (tsi::app::interrupted() && rc != 3) {  // an output that failed is said first
       spdlog::error("interrupted by signal {}: what was computed is written", tsi::app::interrupt_signal());
       return 128 + tsi::app::interrupt_signal();

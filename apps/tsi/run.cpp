@@ -62,31 +62,42 @@ Assembly reference_assembly(const Json& config, const Registry& registry, const 
                          registry, options);
 }
 
-// What the reference will cost, refused before it starts when it would exceed --max-steps: an
-// adaptive solver takes at least substeps_per_period steps per fastest period of the problem.
-void check_reference_cost(const Json& config, const Assembly& a, const Json& scheme_section, double limit) {
+// The steps a reference will take, before it starts: an adaptive solver at least
+// substeps_per_period per fastest period of the problem (NaN for a solver without that setting
+// or a problem without a fast period), a fixed step t_end / reference.h (NaN without one).
+struct ReferenceSteps {
+  double adaptive = std::numeric_limits<double>::quiet_NaN();
+  double fixed = std::numeric_limits<double>::quiet_NaN();
+};
+
+ReferenceSteps reference_steps(const Json& config, const Assembly& a, const Json& scheme_section) {
+  ReferenceSteps steps;
   const Json& ref = config["reference"];
   const double t_end = config["time"]["t_end"];
   const double period = to_double(a.reformulation->fast_period());
-  if (scheme_section.contains("substeps_per_period") && period > 0.0) {
-    const double substeps = scheme_section["substeps_per_period"].get<double>();
-    const double estimate = t_end / period * substeps;  // in double: 1e300 with eps = 1e-300
-    if (!(estimate <= limit))
-      throw ConfigError("reference", fmt::format("{} on the {} problem would take at least {:.3g} steps ({} per fast "
-                                                 "period 2 pi eps / {:g}), more than --max-steps = {:.3g}; use a "
-                                                 "two-scale reference, e.g. {{\"scheme\": \"se2\", \"reformulation\": "
-                                                 "\"two-scale\", \"h\": {}}}, or raise the limit with --max-steps N",
-                                                 a.scheme_entry->info.name, ref["reformulation"].get<std::string>(),
-                                                 estimate, substeps, a.model->max_linear_frequency(), limit,
-                                                 t_end / 4096));
-  }
-  if (!ref["h"].is_null()) {
-    const double estimate = t_end / ref["h"].get<double>();
-    if (!(estimate <= limit))
-      throw ConfigError("reference.h", fmt::format("got {}: {:.3g} steps over t_end = {}; at most {:.3g} "
-                                                   "(--max-steps; raise the limit with --max-steps N)",
-                                                   ref["h"].get<double>(), estimate, t_end, limit));
-  }
+  if (scheme_section.contains("substeps_per_period") && period > 0.0)  // in double: 1e300 with eps = 1e-300
+    steps.adaptive = t_end / period * scheme_section["substeps_per_period"].get<double>();
+  if (!ref["h"].is_null()) steps.fixed = t_end / ref["h"].get<double>();
+  return steps;
+}
+
+// What the reference will cost, refused before it starts when it would exceed --max-steps.
+void check_reference_cost(const Json& config, const Assembly& a, const Json& scheme_section, double limit) {
+  const Json& ref = config["reference"];
+  const double t_end = config["time"]["t_end"];
+  const ReferenceSteps steps = reference_steps(config, a, scheme_section);
+  if (!std::isnan(steps.adaptive) && !(steps.adaptive <= limit))
+    throw ConfigError("reference", fmt::format("{} on the {} problem would take at least {:.3g} steps ({} per fast "
+                                               "period 2 pi eps / {:g}), more than --max-steps = {:.3g}; use a "
+                                               "two-scale reference, e.g. {{\"scheme\": \"se2\", \"reformulation\": "
+                                               "\"two-scale\", \"h\": {}}}, or raise the limit with --max-steps N",
+                                               a.scheme_entry->info.name, ref["reformulation"].get<std::string>(),
+                                               steps.adaptive, scheme_section["substeps_per_period"].get<double>(),
+                                               a.model->max_linear_frequency(), limit, t_end / 4096));
+  if (!std::isnan(steps.fixed) && !(steps.fixed <= limit))
+    throw ConfigError("reference.h", fmt::format("got {}: {:.3g} steps over t_end = {}; at most {:.3g} "
+                                                 "(--max-steps; raise the limit with --max-steps N)",
+                                                 ref["h"].get<double>(), steps.fixed, t_end, limit));
 }
 
 }  // namespace
@@ -152,6 +163,24 @@ void check_reference_cost(const Json& config, const Registry& registry, const Ru
                        settings.max_steps);
 }
 
+ReferenceEstimate estimate_reference(const Json& config, const Registry& registry, const RunSettings& settings) {
+  ReferenceEstimate estimate;
+  const Json& ref = config["reference"];
+  if (ref["scheme"] == exact_reference) {
+    estimate.exact = true;
+    return estimate;
+  }
+  const Json scheme_section =
+      reference_scheme_section(ref, registry.scheme(ref["scheme"], "reference.scheme"), 1.0, 1.0);
+  const ReferenceSteps steps =
+      reference_steps(config, reference_assembly(config, registry, scheme_section, settings), scheme_section);
+  estimate.at_least = !std::isnan(steps.adaptive);
+  estimate.steps = std::isnan(steps.adaptive) ? steps.fixed : std::isnan(steps.fixed) ? steps.adaptive
+                                                                                      : std::max(steps.adaptive, steps.fixed);
+  estimate.accuracy_check = ref.value("estimate_accuracy", true);
+  return estimate;
+}
+
 namespace {
 
 // u(t_end) in model variables from an assembly's initial value in `steps` equal steps, with
@@ -160,14 +189,11 @@ namespace {
 // reference and the error estimate's).
 Vector final_model_state(Assembly& a, double t_end, long steps, const ProgressFn& progress, const char* what) {
   Vector y = a.reformulation->prepare(a.u0);
-  auto last_progress = Clock::now();
+  SteppedClock progress_clock;  // the progress function is called when it is read: every few steps
   integrate(a.bind(Real(t_end) / static_cast<Real>(steps)), y, steps, [&](long n, Real t, const Vector& state) {
     if (!state.allFinite()) throw Error(fmt::format("{}: the state is not finite at t = {:.6g} (step {})", what, to_double(t), n));
     if (interrupted()) throw Error(fmt::format("interrupted by signal {} at t = {:.6g}", interrupt_signal(), to_double(t)));
-    if (progress && seconds_since(last_progress) > 0.5) {
-      progress(static_cast<double>(n) / static_cast<double>(steps), what);
-      last_progress = Clock::now();
-    }
+    if (progress && progress_clock.tick()) progress({what, n, steps, to_double(t), t_end});
     return true;
   }, a.reformulation->repreparation());
   return a.reformulation->read_back(y, t_end);
@@ -427,47 +453,61 @@ void agree_to_start(const Collective& split, const Json& config, const Registry&
                           split.size()));
 }
 
-RunOutcome execute_run(const Json& config, const Registry& registry, const RunSettings& settings,
-                       const ProgressFn& progress, const ReferenceSolution* shared_reference,
-                       const std::string& stream_dir) {
-  RunOutcome outcome;
-  Json& result = outcome.result;
-  result["tsi_version"] = version_string;
-  result["config"] = config;
-  result["warnings"] = Json::array();
-  const auto start = Clock::now();
+namespace {
+
+// output.times, checked: each in [0, t_end], and not with a re-prepared run.
+std::vector<double> checked_output_times(const Json& config) {
+  std::vector<double> times;
+  if (!config.contains("output") || !config["output"].contains("times") || !config["output"]["times"].is_array())
+    return times;
+  const double t_end = config["time"]["t_end"];
+  for (const Json& t : config["output"]["times"]) {
+    if (!(t.get<double>() <= t_end))
+      throw ConfigError(fmt::format("output.times[{}]", times.size()),
+                        fmt::format("got {}, expected a time in [0, t_end = {}]", t.get<double>(), t_end));
+    times.push_back(t.get<double>());
+  }
+  const Json& rconf = config["reformulation"];
+  if (!times.empty() && rconf.contains("reprepare") && rconf["reprepare"] != "never")
+    throw ConfigError("output.times", "cannot be combined with reformulation.reprepare: a re-prepared U is not "
+                                      "smooth in t across its re-preparations, so it is not interpolated there");
+  return times;
+}
+
+}  // namespace
+
+RunPlan plan_run(const Json& config, const Registry& registry, const RunSettings& settings, bool check_reference) {
+  RunPlan plan;
   // Construction: bad input (a model's own checks, u0 of the wrong shape, a run that cannot fit
   // in memory) is a ConfigError that propagates before anything runs. The scheme is bound after
   // the data are prepared: the preparation's temporaries are gone by then.
-  AssemblyOptions assembly_options;  // bound after the preparation (assembly.bind below)
+  AssemblyOptions assembly_options;  // bound after the preparation (assembly.bind in execute_run)
   assembly_options.context = settings.context;
-  Assembly assembly = assemble(resolved_selection(config), registry, assembly_options);
+  plan.assembly = assemble(resolved_selection(config), registry, assembly_options);
+  Assembly& assembly = plan.assembly;
   // A reference that could not finish is refused now, not after the run.
   check_run_steps(config, settings.max_steps);
-  if (config.contains("reference") && !shared_reference) check_reference_cost(config, registry, settings);
+  if (config.contains("reference") && check_reference) check_reference_cost(config, registry, settings);
   const SchemeEntry& scheme_entry = *assembly.scheme_entry;
-  std::shared_ptr<const Model> model = assembly.model;
-  const Vector u0 = assembly.u0;
+  const Model& model = *assembly.model;
+  const Vector& u0 = assembly.u0;
   {  // an initial value whose invariants overflow (entries of 1e300) would only "blow up" at t = 0
     if (!u0.allFinite())
       throw ConfigError("model.u0", "the initial value has non-finite entries; expected finite numbers");
-    const bool hamiltonian = model->has_hamiltonian_structure();
-    const Real H0 = hamiltonian ? model->energy(u0) : 0, I0 = hamiltonian ? model->oscillatory_energy(u0) : 0,
-               m0 = hamiltonian ? model->mass(u0) : 0;
+    const bool hamiltonian = model.has_hamiltonian_structure();
+    const Real H0 = hamiltonian ? model.energy(u0) : 0, I0 = hamiltonian ? model.oscillatory_energy(u0) : 0,
+               m0 = hamiltonian ? model.mass(u0) : 0;
     if (!std::isfinite(H0) || !std::isfinite(I0) || !std::isfinite(m0))
       throw ConfigError("model.u0", fmt::format("H = {}, I = {}, m = {} at the initial value; expected an initial "
                                                 "value whose invariants are finite numbers",
                                                 H0, I0, m0));
   }
-  Reformulation* reformulation = assembly.reformulation.get();
-  Stepper* stepper = nullptr;  // bound once the data are prepared
 
   const auto& rconf = config["reformulation"];
-  const Collective* split = settings.context.collective;  // tsi run --split: this process's share
-  if (split) check_split_run(config, assembly, registry);
+  if (settings.context.collective) check_split_run(config, assembly, registry);  // tsi run --split
   const int data_needed = assembly.traits.data_order_for(assembly.model_entry->linear_remainder);
   if (rconf.contains("initial_data_order") && rconf["initial_data_order"].get<int>() < data_needed) {
-    result["warnings"].push_back(fmt::format(
+    plan.warnings.push_back(fmt::format(
         "scheme \"{}\" needs prepared data of order {} for uniform accuracy; running with order {}",
         scheme_entry.info.name, data_needed, rconf["initial_data_order"].get<int>()));
   }
@@ -478,13 +518,36 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   const int degree = assembly.model_entry->nonlinearity_degree;
   if (rconf.contains("n_tau") && rconf["n_tau"].is_number() && degree > 0 &&
       rconf["n_tau"].get<long>() / 2 - 1 < degree + 1)
-    result["warnings"].push_back(fmt::format(
+    plan.warnings.push_back(fmt::format(
         "reformulation.n_tau = {} cannot hold the tau harmonics of this model's degree-{} nonlinearity "
         "(up to |k| = {}: n_tau >= {} needed); the result aliases them",
         rconf["n_tau"].get<long>(), degree, degree + 1, 2 * (degree + 2)));
+  plan.steps = step_count(config);
+  checked_output_times(config);
+  return plan;
+}
 
+RunOutcome execute_run(const Json& config, const Registry& registry, const RunSettings& settings,
+                       const ProgressFn& progress, const ReferenceSolution* shared_reference,
+                       const std::string& stream_dir) {
+  RunOutcome outcome;
+  Json& result = outcome.result;
+  result["tsi_version"] = version_string;
+  result["config"] = config;
+  result["warnings"] = Json::array();
+  const auto start = Clock::now();
+  RunPlan plan = plan_run(config, registry, settings, !shared_reference);
+  Assembly& assembly = plan.assembly;
+  for (auto& warning : plan.warnings) result["warnings"].push_back(std::move(warning));
+  std::shared_ptr<const Model> model = assembly.model;
+  const Vector u0 = assembly.u0;
+  Reformulation* reformulation = assembly.reformulation.get();
+  Stepper* stepper = nullptr;  // bound once the data are prepared
+
+  const auto& rconf = config["reformulation"];
+  const Collective* split = settings.context.collective;  // tsi run --split: this process's share
   const double h = config["time"]["h"], t_end = config["time"]["t_end"];
-  const long n_steps = step_count(config);
+  const long n_steps = plan.steps;
   if (!stream_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(stream_dir, ec);
@@ -499,23 +562,13 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   };
   // u between the steps (output.times), from the scheme's states interpolated in t.
   std::unique_ptr<DenseOutput> dense;
-  if (config.contains("output") && config["output"].contains("times") && config["output"]["times"].is_array() &&
-      !config["output"]["times"].empty()) {
-    std::vector<double> times;
-    for (const Json& t : config["output"]["times"]) {
-      if (!(t.get<double>() <= t_end))
-        throw ConfigError(fmt::format("output.times[{}]", times.size()),
-                          fmt::format("got {}, expected a time in [0, t_end = {}]", t.get<double>(), t_end));
-      times.push_back(t.get<double>());
-    }
-    if (rconf.contains("reprepare") && rconf["reprepare"] != "never")
-      throw ConfigError("output.times", "cannot be combined with reformulation.reprepare: a re-prepared U is not "
-                                        "smooth in t across its re-preparations, so it is not interpolated there");
+  if (std::vector<double> times = checked_output_times(config); !times.empty())
     dense = std::make_unique<DenseOutput>(std::move(times), std::min(assembly.traits.order, 8), h, n_steps, *model,
                                           *reformulation);
-  }
   std::string status = "completed";
-  auto last_progress = Clock::now(), last_checkpoint = Clock::now();
+  auto last_checkpoint = Clock::now();
+  // Clocks read every few steps only: a cheap step pays no clock read.
+  SteppedClock checkpoint_clock, progress_clock;
   const double checkpoint_seconds = config.contains("output") ? config["output"].value("checkpoint_seconds", 30.0) : 30.0;
   const long state_every = config.contains("output") ? config["output"].value("state_every", 0L) : 0L;
   // A checkpoint: result.json says how far the run got, so that a kill -9 or a power cut
@@ -556,10 +609,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
                                       interrupted() ? interrupt_signal() : 0, t, n, n_steps);
         return false;
       }
-      if (progress && seconds_since(last_progress) > 0.5) {
-        progress(static_cast<double>(n) / static_cast<double>(std::max(1L, n_steps)), "run");
-        last_progress = Clock::now();
-      }
+      if (progress && progress_clock.tick()) progress({"run", n, n_steps, to_double(t), t_end});
       if (go_on && state_every > 0 && (split || !stream_dir.empty()) && (n % state_every == 0 || n == n_steps)) {
         // The state as a file a run can start from (written to a temporary file, then renamed),
         // and result.json's checkpoint says at which time it is.
@@ -573,7 +623,10 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
           checkpoint(n, to_double(t));
         }
       }
-      if (go_on && !stream_dir.empty() && seconds_since(last_checkpoint) > checkpoint_seconds) checkpoint(n, to_double(t));
+      if (go_on && !stream_dir.empty())
+        if (const auto now = checkpoint_clock.tick();
+            now && std::chrono::duration<double>(*now - last_checkpoint).count() > checkpoint_seconds)
+          checkpoint(n, to_double(t));
       return go_on;
     }, reformulation->repreparation());
     if (status == "completed" && recorder.status() != "running") {

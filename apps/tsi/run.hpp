@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "progress.hpp"
+#include "tsi/assembly.hpp"
 #include "tsi/collective.hpp"
 #include "tsi/error.hpp"
 #include "tsi/params.hpp"
@@ -91,9 +93,36 @@ void check_reference_cost(const Json& resolved, const Registry& registry, const 
 /// when it has a reference.
 void check_work_estimate(const Json& resolved, const Registry& registry, const RunSettings& settings);
 
-/// Called now and then with the fraction done of what is being computed ("run", or
-/// "reference" and "reference check" for the reference's two solves), for a progress line.
-using ProgressFn = std::function<void(double fraction, const char* what)>;
+/// Called after a step of what is being computed ("run", "reference" and "reference check" for
+/// the reference's two solves, the error estimate's runs), for a progress line: at the first
+/// step, then every few steps (whenever a SteppedClock reads the time, a few ms apart), so that
+/// a step pays a decrement and a compare.
+using ProgressFn = std::function<void(const StepProgress&)>;
+
+/// A run's objects built and checked as the run builds and checks them before its first step
+/// (the same errors): what execute_run integrates, and what `tsi run --dry-run` reports.
+struct RunPlan {
+  Assembly assembly;
+  long steps = 0;                     ///< t_end / h
+  std::vector<std::string> warnings;  ///< result.json's warnings known before the run
+};
+
+/// Builds a resolved config's objects and checks them: the model's own checks, the memory of a
+/// two-scale run, the step counts against --max-steps (and the reference's unless
+/// `check_reference` is false: a study's shared reference is checked once), an initial value
+/// with finite invariants, output.times, and what a split run cannot do. ConfigError naming
+/// the field on bad input; nothing is written.
+RunPlan plan_run(const Json& resolved, const Registry& registry, const RunSettings& settings,
+                 bool check_reference = true);
+
+/// The work of a reference, estimated before it starts as check_reference_cost checks it.
+struct ReferenceEstimate {
+  bool exact = false;           ///< the model's exact solution: no steps
+  double steps = 0.0;           ///< t_end / reference.h, or an adaptive solver's lower bound
+  bool at_least = false;        ///< steps is a lower bound (an adaptive solver's)
+  bool accuracy_check = false;  ///< a second solve at tighter settings estimates its accuracy
+};
+ReferenceEstimate estimate_reference(const Json& resolved, const Registry& registry, const RunSettings& settings);
 
 /// Computes the reference solution a resolved config asks for ("reference" section).
 ReferenceSolution compute_reference(const Json& resolved, const Registry& registry, const RunSettings& settings,

@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -26,12 +25,10 @@ std::string shell_quoted(const std::string& s) { return "'" + s + "'"; }
 
 }  // namespace
 
-StudyProgressFn terminal_progress(bool tty, std::chrono::steady_clock::time_point start) {
-  return [tty, start](size_t done, size_t total) {
-    if (!tty) return;
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const double estimate = done ? elapsed * static_cast<double>(total - done) / static_cast<double>(done) : 0.0;
-    fmt::print(stderr, "\r  {}/{} done, {:.1f} s elapsed, about {:.0f} s to go   ", done, total, elapsed, estimate);
+StudyProgressFn study_progress(ProgressLine& line) {
+  return [&line](const StudyProgress& p) {
+    const auto now = line.now();
+    if (line.due(now)) line.offer(now, study_progress_text(p, line.elapsed(now)));
   };
 }
 
@@ -78,7 +75,7 @@ int study_exit_code(const Json& rows, const std::vector<std::string>& io_errors)
 
 int study_command(PluginLoader& loader, Registry& registry, const std::string& study_path, std::string out_dir,
                   int jobs, const std::vector<std::string>& overrides, bool plots, const RunSettings& settings,
-                  bool resume, bool force) {
+                  bool resume, bool force, bool quiet) {
   Json spec = load_config_file(study_path);
   if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
     load_config_plugins(loader, spec["base"]["plugins"], study_path);
@@ -113,17 +110,16 @@ int study_command(PluginLoader& loader, Registry& registry, const std::string& s
   }
   if (jobs <= 0) jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 
-  const bool tty = isatty(fileno(stderr));
+  ProgressLine line(stderr_progress_mode(quiet));
   const auto start = Clock::now();
-  const StudyProgressFn progress = terminal_progress(tty, start);
-  if (tty) fmt::print(stderr, "  {} runs on {} threads\n", study.runs.size() - kept, jobs);
+  if (line.mode() == ProgressMode::terminal) fmt::print(stderr, "  {} runs on {} threads\n", study.runs.size() - kept, jobs);
   if (resume) fmt::print("  resumed: {} of {} runs finished earlier are kept, {} to run\n", kept, study.runs.size(),
                          study.runs.size() - kept);
-  auto outcomes = run_study(study, registry, jobs, progress, out_dir, skip);
+  auto outcomes = run_study(study, registry, jobs, line.enabled() ? study_progress(line) : StudyProgressFn(), out_dir, skip);
   for (size_t i = 0; i < outcomes.size(); ++i)
     if (skip[i]) outcomes[i] = std::move(finished[i]);
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  if (tty) fmt::print(stderr, "\r{:70}\r", "");
+  line.finish();  // before the tables
 
   const Json rows = study_rows(study, outcomes);
   // Every run's files, then the table; an output that could not be written is exit code 3.

@@ -1,8 +1,8 @@
 #pragma once
-#include <chrono>
 #include <string>
 #include <vector>
 
+#include "progress.hpp"
 #include "study_runner.hpp"
 #include "tsi/plugin_loader.hpp"
 
@@ -14,12 +14,14 @@ namespace tsi::app {
 /// `resume`: the runs of this same study already finished in out_dir (result.json with status
 /// completed or blow-up, and invariants.csv) are kept and not run again. `force`: results of
 /// another study in out_dir are replaced instead of refused.
+/// `quiet`: no progress line (--quiet).
 int study_command(PluginLoader& loader, Registry& registry, const std::string& study_path,
                   std::string out_dir, int jobs, const std::vector<std::string>& overrides, bool plots,
-                  const RunSettings& settings, bool resume = false, bool force = false);
+                  const RunSettings& settings, bool resume = false, bool force = false, bool quiet = false);
 
-/// A study's progress line on stderr (done/total, elapsed, time to go), silent when not `tty`.
-StudyProgressFn terminal_progress(bool tty, std::chrono::steady_clock::time_point start);
+/// A study's progress on `line` (units done of all, the current run, time left), throttled
+/// by the line.
+StudyProgressFn study_progress(ProgressLine& line);
 
 /// The plotting script (python3 + matplotlib) next to the sources or the installed runner.
 std::string plot_script_path();

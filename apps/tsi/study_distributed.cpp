@@ -12,8 +12,11 @@
 #include <thread>
 
 #include "config.hpp"
+#include "dry_run.hpp"
+#include "progress.hpp"
 #include "plugin_setup.hpp"
 #include "run_files.hpp"
+#include "split_processes.hpp"
 #include "study_command.hpp"
 #include "study_report.hpp"
 #include "study_runner.hpp"
@@ -82,16 +85,14 @@ int shard_command(PluginLoader& loader, Registry& registry, const StudyCli& cli,
   for (size_t i : mine) part.runs.push_back(study.runs[i]);
   const int jobs = default_jobs(cli.jobs);
 
-  const bool tty = isatty(fileno(stderr));
+  ProgressLine line(stderr_progress_mode(cli.quiet));
   const auto start = Clock::now();
-  auto progress = [&](size_t done, size_t total) {
-    if (tty) fmt::print(stderr, "\r  {}/{} done   ", done, total);
-  };
-  if (tty) fmt::print(stderr, "  shard {}/{}: {} of {} runs on {} threads\n", shard.index, shard.count,
-                      part.runs.size(), study.runs.size(), jobs);
-  const auto outcomes = run_study(part, registry, jobs, progress, out_dir);
+  if (line.mode() == ProgressMode::terminal)
+    fmt::print(stderr, "  shard {}/{}: {} of {} runs on {} threads\n", shard.index, shard.count, part.runs.size(),
+               study.runs.size(), jobs);
+  const auto outcomes = run_study(part, registry, jobs, line.enabled() ? study_progress(line) : StudyProgressFn(), out_dir);
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  if (tty) fmt::print(stderr, "\r{:70}\r", "");
+  line.finish();  // before the summary
 
   // Every run's files (a run that could not write its own is exit code 3, as without shards).
   std::vector<std::string> io_errors = io_errors_of(part.runs, outcomes);
@@ -303,8 +304,30 @@ std::vector<size_t> shard_runs(const Study& study, long index, long count) {
   return mine;
 }
 
+// --- a dry run ------------------------------------------------------------------------------------
+
+// The study (or the shard's part of it) expanded and checked as it would run, summarised on
+// stdout; nothing is written. Under mpirun, rank 0 alone says it.
+int study_dry_run_command(PluginLoader& loader, Registry& registry, const StudyCli& cli, const ShardSpec& shard) {
+  if (launched_rank() != 0) return 0;
+  const Study study = load_study(loader, registry, cli.study_path, cli.overrides, cli.settings);
+  Study part = study;
+  if (!cli.shard.empty()) {
+    part.runs.clear();
+    for (size_t i : shard_runs(study, shard.index, shard.count)) part.runs.push_back(study.runs[i]);
+  }
+  std::string text;
+  const int rc = study_dry_run(cli.study_path, part, registry, default_jobs(cli.jobs), text);
+  if (!cli.shard.empty())
+    text += fmt::format("  shard {}/{}: {} of the study's {} runs\n", shard.index, shard.count, part.runs.size(),
+                        study.runs.size());
+  fmt::print("{}", text);
+  return rc;
+}
+
 int study_entry(PluginLoader& loader, Registry& registry, const StudyCli& cli) {
   if (!cli.merge_dirs.empty()) {
+    if (cli.dry_run) throw ConfigError("--dry-run", "cannot be combined with --merge (which only reads shards)");
     if (!cli.study_path.empty())
       throw ConfigError("--merge", "takes shard directories only, not a study file (got \"" + cli.study_path +
                                        "\" too): tsi study --merge DIR1 DIR2 ... --out DIR");
@@ -320,6 +343,7 @@ int study_entry(PluginLoader& loader, Registry& registry, const StudyCli& cli) {
   if (cli.resume && cli.force) throw ConfigError("--resume", "cannot be combined with --force (which replaces the results)");
   if ((cli.resume || cli.force) && !cli.shard.empty())
     throw ConfigError(cli.resume ? "--resume" : "--force", "applies to a whole study, not to a shard");
+  if (cli.dry_run) return study_dry_run_command(loader, registry, cli, shard);
 #ifdef TSI_WITH_MPI
   if (mpi_launched()) {
     if (!cli.shard.empty()) throw ConfigError("--shard", "cannot be combined with mpirun: use one or the other");

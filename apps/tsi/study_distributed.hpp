@@ -22,6 +22,8 @@ struct StudyCli {
   bool resume = false;                  ///< --resume: keep the finished runs of this study in --out
   bool force = false;                   ///< --force: replace another study's results in --out
   RunSettings settings;                 ///< --threads, --fft-threads, --max-steps
+  bool dry_run = false;                 ///< --dry-run: check and summarise, run and write nothing
+  bool quiet = false;                   ///< --quiet: no progress line
 };
 
 /// Runs `tsi study` as the command line asks: the whole study (study_command), one shard of

@@ -34,6 +34,7 @@
 #include "interrupt.hpp"
 #include "plugin_setup.hpp"
 #include "run_files.hpp"
+#include "progress.hpp"
 #include "study_command.hpp"
 #include "study_distributed.hpp"
 #include "study_runner.hpp"
@@ -492,21 +493,24 @@ int mpi_study_command(PluginLoader& loader, Registry& registry, const StudyCli& 
     return worker_main(*plan, registry);
   }
 
-  const bool tty = isatty(fileno(stderr));
+  ProgressLine line(stderr_progress_mode(cli.quiet));  // rank 0's only
   const auto start = Clock::now();
-  const StudyProgressFn progress = terminal_progress(tty, start);
+  const StudyProgressFn show = study_progress(line);
   if (cli.jobs > 1) fmt::print(stderr, "tsi: note: --jobs is not used under mpirun; each rank runs one run at a time\n");
-  if (tty) fmt::print(stderr, "  {} runs on {} MPI ranks\n", plan->study.runs.size(), ranks);
+  if (line.mode() == ProgressMode::terminal) fmt::print(stderr, "  {} runs on {} MPI ranks\n", plan->study.runs.size(), ranks);
   std::vector<RunOutcome> outcomes;
   try {
-    outcomes = Master(*plan, ranks).run(registry, progress);
+    outcomes = Master(*plan, ranks).run(registry, [&](size_t done, size_t total) {
+      if (line.enabled()) show({done, total, 0, 0.0, std::string(), 0.0});
+    });
   } catch (const std::exception& e) {
+    line.finish();
     fmt::print(stderr, "tsi: error: {}\n", e.what());
     std::fflush(stderr);
     MPI_Abort(MPI_COMM_WORLD, 3);
   }
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  if (tty) fmt::print(stderr, "\r{:70}\r", "");
+  line.finish();  // before the tables
 
   const Json rows = study_rows(plan->study, outcomes);
   write_study_table(plan->out_dir, plan->study, rows, wall, ranks, {{"mpi_ranks", ranks}});

@@ -2,11 +2,13 @@
 
 #include <fmt/format.h>
 
-#include <atomic>
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <future>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -83,14 +85,55 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
       reference_configs.push_back(&run.config);
   }
   const size_t total = reference_configs.size() + study.runs.size();
-  std::atomic<size_t> done{0};
+  // Where the study is, for its progress line: the units finished, those under way with their
+  // fraction done, and the one last started or advanced.
   std::mutex progress_mutex;
-  auto tick = [&] {
-    const size_t d = ++done;
-    if (progress) {
-      std::lock_guard<std::mutex> lock(progress_mutex);
-      progress(d, total);
+  size_t done = 0;
+  std::map<size_t, double> under_way;  // task -> fraction done
+  std::string current;
+  size_t current_task = 0;
+  const auto report = [&] {  // under progress_mutex
+    StudyProgress p{done, total, under_way.size(), 0.0, current, 0.0};
+    for (const auto& [task, fraction] : under_way) p.running_done += fraction;
+    if (const auto it = under_way.find(current_task); it != under_way.end()) p.current_fraction = it->second;
+    progress(p);
+  };
+  const auto unit_name = [&](size_t task) {
+    return task < reference_configs.size() ? std::string("reference") : study.runs[task - reference_configs.size()].id;
+  };
+  const auto started = [&](size_t task) {
+    if (!progress) return;
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    under_way[task] = 0.0;
+    current = unit_name(task);
+    current_task = task;
+    report();
+  };
+  auto tick = [&](size_t task) {
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    ++done;
+    if (!progress) return;
+    under_way.erase(task);
+    if (current_task == task) {  // another unit under way, if any, is the current one
+      current = under_way.empty() ? std::string() : unit_name(under_way.begin()->first);
+      current_task = under_way.empty() ? total : under_way.begin()->first;
     }
+    report();
+  };
+  // A unit's steps (every few steps, execute_run's calls) passed on at most every quarter
+  // second: a long run keeps the line moving.
+  const auto unit_progress = [&](size_t task) -> ProgressFn {
+    if (!progress) return {};
+    return [&, task, last = std::make_shared<ProgressClock::time_point>(ProgressClock::now())](const StepProgress& p) {
+      const auto now = ProgressClock::now();
+      if (now - *last < std::chrono::milliseconds(250)) return;
+      *last = now;
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      under_way[task] = p.steps > 0 ? static_cast<double>(p.step) / static_cast<double>(p.steps) : 0.0;
+      current = unit_name(task);
+      current_task = task;
+      report();
+    };
   };
 
   // The references first (the smallest eps, the longest, first), then the runs, from one
@@ -113,20 +156,21 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
   const size_t n_references = reference_configs.size();
   parallel_for(n_references + study.runs.size(), jobs, [&](size_t task) {
     if (task < n_references) {
+      started(task);
       try {
-        references[task] = compute_reference(*reference_configs[task], registry, study.settings);
+        references[task] = compute_reference(*reference_configs[task], registry, study.settings, unit_progress(task));
       } catch (const std::exception& e) {
         reference_errors[task] = e.what();
       } catch (...) {
         reference_errors[task] = "an unknown error";
       }
       computed[task].set_value();  // always: the runs waiting for it go on
-      tick();
+      tick(task);
       return;
     }
     const size_t i = task - n_references;
     if (skipped(i)) {  // its outcome is the caller's (resumed from its files)
-      tick();
+      tick(task);
       return;
     }
     const StudyRun& run = study.runs[i];
@@ -134,7 +178,7 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
     const auto not_run = [&] {  // not started (its reference may have been cut short too)
       outcomes[i] = failed_run_outcome(run, fmt::format("not run: the study was interrupted by signal {}", interrupt_signal()));
       outcomes[i].result["status"] = "interrupted";
-      tick();
+      tick(task);
     };
     if (interrupted()) return not_run();
     if (run.config.contains("reference")) {
@@ -143,13 +187,14 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
       if (interrupted()) return not_run();
       if (!reference_errors[r].empty()) {
         outcomes[i] = failed_run_outcome(run, "the reference solution failed: " + reference_errors[r]);
-        tick();
+        tick(task);
         return;
       }
       reference = &references[r];
     }
+    started(task);
     try {
-      outcomes[i] = execute_run(run.config, registry, study.settings, {}, reference,
+      outcomes[i] = execute_run(run.config, registry, study.settings, unit_progress(task), reference,
                                 out_dir.empty() ? std::string() : out_dir + "/runs/" + run.id);
     } catch (const IoError& e) {  // its output directory could not be made or written
       outcomes[i] = failed_run_outcome(run, e.what());
@@ -157,7 +202,7 @@ std::vector<RunOutcome> run_study(const Study& study, const Registry& registry, 
     } catch (const std::exception& e) {
       outcomes[i] = failed_run_outcome(run, e.what());
     }
-    tick();
+    tick(task);
   });
   return outcomes;
 }

@@ -2,13 +2,16 @@
 #include <functional>
 #include <vector>
 
+#include "progress.hpp"
 #include "run.hpp"
 #include "study_spec.hpp"
 
 namespace tsi::app {
 
-/// Called after each unit of work (a reference or a run) with the units done and in all.
-using StudyProgressFn = std::function<void(size_t done, size_t total)>;
+/// Called when a unit of work (a reference or a run) starts or finishes, and now and then (at
+/// most every quarter second per unit) while it runs, with where the study is; calls are
+/// serialised.
+using StudyProgressFn = std::function<void(const StudyProgress&)>;
 
 /// Runs every run of a study on `jobs` worker threads. References are computed first, once
 /// per distinct reference_key, and shared. A run that fails, or whose reference fails, is

@@ -12,6 +12,7 @@
 #include <condition_variable>
 #include <csignal>
 #include <exception>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -21,8 +22,10 @@
 #include "interrupt.hpp"
 #include "list_command.hpp"
 #include "plugin_setup.hpp"
+#include "progress.hpp"
 #include "run.hpp"
 #include "run_files.hpp"
+#include "study_command.hpp"
 #include "study_report.hpp"
 #include "study_runner.hpp"
 #include "study_spec.hpp"
@@ -61,7 +64,7 @@ Json parse(const std::string& text, const std::string& origin) {
 // becomes the runner's interrupt request, and the run or study stops at its next step and
 // returns what it has (status "interrupted"). Exceptions of `work` are rethrown here.
 template <class Result, class Work>
-Result interruptible(Work&& work, bool& was_interrupted) {
+Result interruptible(Work&& work, bool& was_interrupted, const std::function<void()>& while_waiting = {}) {
   std::mutex mutex;
   std::condition_variable cv;
   bool done = false;
@@ -86,6 +89,7 @@ Result interruptible(Work&& work, bool& was_interrupted) {
       std::unique_lock<std::mutex> lock(mutex);
       finished = cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; });
     }
+    if (while_waiting) while_waiting();
     if (finished) break;
     if (PyErr_CheckSignals() != 0) {  // KeyboardInterrupt (or another handler's exception)
       PyErr_Clear();
@@ -383,6 +387,46 @@ void register_python_field(const std::string& name, py::object function, long di
 
 // ---- Runs and studies -------------------------------------------------------------------------
 
+// The progress line of tsi.run / tsi.study (progress=True), drawn as on a terminal (one line
+// rewritten with '\r', at most once a second) on Python's sys.stderr, which a notebook shows
+// under its cell. The computation's threads leave the text here; the waiting thread, which
+// holds the GIL, writes it (write()).
+class PythonProgress {
+ public:
+  explicit PythonProgress(bool enabled)
+      : line_(enabled ? tsi::app::ProgressMode::terminal : tsi::app::ProgressMode::off,
+              [this](std::string_view text) {
+                std::lock_guard<std::mutex> lock(mutex_);
+                pending_ += text;
+              }) {}
+  tsi::app::ProgressLine& line() { return line_; }
+  /// Writes what the line has drawn since the last call (the GIL held).
+  void write() {
+    std::string text;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      text.swap(pending_);
+    }
+    if (text.empty()) return;
+    try {
+      py::object stderr_stream = py::module_::import("sys").attr("stderr");
+      stderr_stream.attr("write")(text);
+      stderr_stream.attr("flush")();
+    } catch (const py::error_already_set&) {  // no usable sys.stderr: the line is not shown
+    }
+  }
+  /// Erases the line (before the result is shown).
+  void finish() {
+    line_.finish();
+    write();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::string pending_;
+  tsi::app::ProgressLine line_;  // last: its destructor may still write to pending_
+};
+
 // A state as numpy (float64 for a real model, complex128 for a complex one, in the shape of
 // its .npy file), None when there is none. States cross as arrays, never through JSON:
 // result.json holds a large one only as the name of its file.
@@ -418,7 +462,7 @@ py::dict outcome_dict(const tsi::app::RunOutcome& outcome) {
   return d;
 }
 
-py::dict run(const std::string& config_text, const std::string& out_dir, int threads) {
+py::dict run(const std::string& config_text, const std::string& out_dir, int threads, bool show_progress) {
   if (threads < 0) throw tsi::ConfigError("threads", "got " + std::to_string(threads) + ", expected at least 1 (or None: all cores)");
   tsi::Registry& registry = session_registry();
   const Json raw = parse(config_text, "config");
@@ -431,8 +475,15 @@ py::dict run(const std::string& config_text, const std::string& out_dir, int thr
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const auto settings =
       tsi::app::RunSettings::from_flags(threads > 0 ? threads : cores, 1, tsi::app::default_max_steps);
+  PythonProgress progress(show_progress);
+  tsi::app::StepProgressLine steps(progress.line());
   const auto outcome = interruptible<tsi::app::RunOutcome>(
-      [&] { return tsi::app::execute_run(config, registry, settings); }, was_interrupted);
+      [&] {
+        return tsi::app::execute_run(config, registry, settings,
+                                     show_progress ? tsi::app::ProgressFn(std::ref(steps)) : nullptr);
+      },
+      was_interrupted, [&] { progress.write(); });
+  progress.finish();
   if (!out_dir.empty()) tsi::app::write_run_files(out_dir, outcome);
   py::dict d = outcome_dict(outcome);
   d["interrupted"] = was_interrupted;
@@ -440,7 +491,7 @@ py::dict run(const std::string& config_text, const std::string& out_dir, int thr
 }
 
 py::dict study(const std::string& spec_text, int jobs, const std::vector<std::string>& overrides,
-               const std::string& out_dir) {
+               const std::string& out_dir, bool show_progress) {
   tsi::Registry& registry = session_registry();
   const Json spec = parse(spec_text, "study");
   if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
@@ -450,8 +501,14 @@ py::dict study(const std::string& spec_text, int jobs, const std::vector<std::st
   if (!out_dir.empty()) tsi::app::prepare_output_dir(out_dir);
   bool was_interrupted = false;
   const auto start = std::chrono::steady_clock::now();
+  PythonProgress progress(show_progress);
   const auto outcomes = interruptible<std::vector<tsi::app::RunOutcome>>(
-      [&] { return tsi::app::run_study(expanded, registry, jobs); }, was_interrupted);
+      [&] {
+        return tsi::app::run_study(expanded, registry, jobs,
+                                   show_progress ? tsi::app::study_progress(progress.line()) : nullptr);
+      },
+      was_interrupted, [&] { progress.write(); });
+  progress.finish();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const Json rows = tsi::app::study_rows(expanded, outcomes);
   if (!out_dir.empty()) tsi::app::write_study_files(out_dir, expanded, outcomes, rows, wall, jobs);
@@ -522,9 +579,9 @@ PYBIND11_MODULE(_tsi, m) {
         py::arg("what") = "");
   m.def("load_plugin", [](const std::string& path) { loader().load(path); }, py::arg("path"));
   m.def("plugin_directory", &tsi::PluginLoader::default_directory);
-  m.def("run", &run, py::arg("config"), py::arg("out") = "", py::arg("threads") = 0);
+  m.def("run", &run, py::arg("config"), py::arg("out") = "", py::arg("threads") = 0, py::arg("progress") = false);
   m.def("study", &study, py::arg("spec"), py::arg("jobs") = 0, py::arg("overrides") = std::vector<std::string>(),
-        py::arg("out") = "");
+        py::arg("out") = "", py::arg("progress") = false);
   m.def("register_field", &register_python_field, py::arg("name"), py::arg("f"), py::arg("dim") = 0,
         py::arg("time_dependent") = false, py::arg("is_complex") = false, py::arg("u0") = py::none(),
         py::arg("summary") = "");

@@ -20,6 +20,7 @@ import itertools
 import json
 import math
 import os
+import sys
 import warnings
 
 import numpy as np
@@ -217,12 +218,20 @@ class StudyResult:
         return f"<tsi.StudyResult {self.kind} {self.title!r}: {len(self.rows)} runs, {failed} not completed>"
 
 
-def run(config, *, out=None, threads=None):
+def _progress(progress):
+    # Default: on in a Jupyter notebook (its kernel is loaded), off in a script.
+    return "ipykernel" in sys.modules if progress is None else bool(progress)
+
+
+def run(config, *, out=None, threads=None, progress=None):
     """Runs one config (a dict, as the JSON of `tsi run`) and returns a RunResult. With `out`,
     also writes result.json and invariants.csv there. A run that fails or blows up part-way
     is returned with its status and message; bad input raises tsi.ConfigError. `threads`:
-    threads for a large two-scale tau grid, as `tsi --threads` (default: all cores)."""
-    native = _tsi.run(_dumps(config), os.fspath(out) if out else "", int(threads or 0))
+    threads for a large two-scale tau grid, as `tsi --threads` (default: all cores).
+    `progress`: a line on sys.stderr (step, t, simulated time per second, time left),
+    rewritten at most once a second and erased at the end; default on in a Jupyter notebook,
+    off elsewhere."""
+    native = _tsi.run(_dumps(config), os.fspath(out) if out else "", int(threads or 0), _progress(progress))
     result = RunResult(native)
     if native["interrupted"]:
         raise Interrupted(result)
@@ -237,12 +246,14 @@ def _overrides(overrides):
     return builtins.list(overrides)
 
 
-def study(spec, jobs=None, *, overrides=None, out=None):
+def study(spec, jobs=None, *, overrides=None, out=None, progress=None):
     """Runs a study (a dict, as the JSON of `tsi study`) on `jobs` threads (default: all
     cores) and returns a StudyResult. `overrides` are --set assignments on the base, a dict
     {"path": value} or a list of "path=value"; with `out`, the study's files are written there
-    (table.csv, study.json, runs/)."""
-    native = _tsi.study(_dumps(spec), int(jobs or 0), _overrides(overrides), os.fspath(out) if out else "")
+    (table.csv, study.json, runs/). `progress`: a line on sys.stderr (runs done of all, the
+    current run, time left), as tsi.run's; default on in a Jupyter notebook, off elsewhere."""
+    native = _tsi.study(_dumps(spec), int(jobs or 0), _overrides(overrides), os.fspath(out) if out else "",
+                        _progress(progress))
     result = StudyResult(native)
     if native["interrupted"]:
         raise Interrupted(result)

@@ -1,6 +1,8 @@
 // `tsi list`: what the runner knows, as text and as JSON, and its usage errors.
 #include <doctest/doctest.h>
 
+#include <set>
+#include <sstream>
 #include <string>
 
 #include "run_command.hpp"
@@ -28,11 +30,11 @@ bool has_string(const Json& list, const std::string& s) {
   return false;
 }
 
-Json list_json(const std::vector<std::string>& extra = {}) {
+Json list_json(const std::vector<std::string>& extra = {}, const CommandEnv& env = {}) {
   std::vector<std::string> args = {"list"};
   args.insert(args.end(), extra.begin(), extra.end());
   args.push_back("--json");
-  const CommandResult r = run_tsi(args);
+  const CommandResult r = run_tsi(args, env);
   INFO(r.describe());
   REQUIRE(r.exit_code == 0);
   return Json::parse(r.out);
@@ -175,6 +177,73 @@ TEST_CASE("list: an unknown kind is bad input") {
     CHECK(contains(r.err, "\"bogus\""));
     CHECK(contains(r.err, "models, reformulations, schemes or fields"));
     CHECK(r.out.empty());
+  }
+}
+
+// `tsi --plugin FILE list` marks exactly what FILE registered: the fixture "general" adds the
+// model fixture-quickstart and the fields fixture-quickstart-f and fixture-linear. The fixture
+// "good", loaded beside it through TSI_PLUGIN_PATH, and the shipped plugins stay unmarked.
+TEST_CASE("list --plugin FILE: exactly the entries FILE registered are marked") {
+  // (paths built with fs::path: g++ 12 -O3 warns falsely on fixture_plugin's string sums here)
+  const fs::path fixtures(TSI_TEST_FIXTURE_DIR);
+  const std::string general = (fixtures / "tsi_fixture_general.so").string();
+  const std::string good = (fixtures / "tsi_fixture_good.so").string();
+  CommandEnv env;
+  env.set["TSI_PLUGIN_PATH"] = good;
+  const std::set<std::string> expected = {"models/fixture-quickstart", "fields/fixture-quickstart-f",
+                                          "fields/fixture-linear"};
+
+  SUBCASE("json: from_plugin_option on FILE's entries alone, named by a relative path") {
+    // the loader records the file's canonical path; the marks must follow it
+    const fs::path file(general);
+    const CommandResult r = run_tsi({"--plugin", file.filename().string(), "list", "--json"}, env,
+                                    file.parent_path().string());
+    INFO(r.describe());
+    REQUIRE(r.exit_code == 0);
+    const Json all = Json::parse(r.out);
+    std::set<std::string> marked, from_general;
+    std::size_t entries = 0;
+    for (const char* kind : {"models", "reformulations", "schemes", "fields"})
+      for (const auto& e : all.at(kind)) {
+        ++entries;
+        const std::string id = std::string(kind) + "/" + e.at("name").get<std::string>();
+        if (e.at("from_plugin_option").get<bool>()) marked.insert(id);
+        if (ends_with(e.at("provider").get<std::string>(), "/tsi_fixture_general.so")) from_general.insert(id);
+      }
+    CHECK(marked == expected);
+    CHECK(from_general == expected);
+    // the neighbours really are there, unmarked: the plugin path's fixture and a shipped model
+    CHECK(entry_named(all.at("models"), "fixture-model").at("from_plugin_option") == false);
+    CHECK(entry_named(all.at("schemes"), "fixture-scheme").at("from_plugin_option") == false);
+    CHECK(entry_named(all.at("models"), "henon-heiles").at("from_plugin_option") == false);
+    CHECK(entries > expected.size() + 10);
+  }
+
+  SUBCASE("text: a trailing [from FILE] on FILE's entries alone") {
+    const CommandResult r = run_tsi({"--plugin", general, "list"}, env);
+    INFO(r.describe());
+    REQUIRE(r.exit_code == 0);
+    std::set<std::string> marked;
+    std::string kind;
+    std::istringstream lines(r.out);
+    for (std::string line; std::getline(lines, line);) {
+      if (!line.empty() && line.back() == ':' && line[0] != ' ') kind = line.substr(0, line.size() - 1);
+      if (line.find("[from") == std::string::npos) continue;
+      CHECK(ends_with(line, "  [from tsi_fixture_general.so]"));
+      const std::size_t start = line.find_first_not_of(' ');
+      marked.insert(kind + "/" + line.substr(start, line.find(' ', start) - start));
+    }
+    CHECK(marked == expected);
+  }
+
+  SUBCASE("without --plugin nothing is marked") {
+    const Json all = list_json({}, env);
+    for (const char* kind : {"models", "reformulations", "schemes", "fields"})
+      for (const auto& e : all.at(kind)) CHECK(e.at("from_plugin_option") == false);
+    CHECK(entry_named(all.at("models"), "fixture-model").is_object());  // loaded, yet unmarked
+    const CommandResult r = run_tsi({"list"}, env);
+    CHECK(r.exit_code == 0);
+    CHECK_FALSE(contains(r.out, "[from"));
   }
 }
 

@@ -58,7 +58,7 @@ std::vector<std::vector<double>> csv_rows(const t::fs::path& file) {
 // A plasma of 2048 of the peer's particles (tests/data/uapic) on its 128 x 64 grid, 8 steps.
 t::Json particle_config(const std::string& scheme) {
   return {{"model",
-           {{"name", "vlasov-poisson-2d"}, {"eps", 0.1}, {"particles", std::string(TSI_TEST_SOURCE_DIR) + "/tests/data/uapic/n2048_init.bin"},
+           {{"name", "vlasov-poisson-2d"}, {"eps", 0.1}, {"particles", tsi::test::path_text({TSI_TEST_SOURCE_DIR, "/tests/data/uapic/n2048_init.bin"})},
             {"n_x", 128}, {"n_y", 64}, {"k_x", 0.5}, {"k_y", 1.0}}},
           {"reformulation", {{"name", "two-scale"}, {"n_tau", 16}}},
           {"scheme", {{"name", scheme}}},

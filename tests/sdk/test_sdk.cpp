@@ -1,8 +1,9 @@
-// The plugin SDK end to end: `cmake --install` into a temporary prefix, then
-// examples/plugins/fput configured and built from its own build directory against that
-// prefix alone (find_package(tsi)), loaded by the installed runner with --plugin and with
-// TSI_PLUGIN_PATH, uniformly second order with SE1, and passing `tsi check`; the same for the
-// scheme example examples/plugins/expmid; and the public headers on their own.
+// The plugin SDK end to end: `cmake --install` into a temporary prefix, then every example
+// plugin the prefix ships (share/tsi/examples/plugins: the Hamiltonian model fput, the scheme
+// expmid, the general-class model van_der_pol) configured and built from there, in a build
+// directory of its own, against that prefix alone (find_package(tsi)), loaded by the installed
+// runner, passing `tsi check`, and run with a measured order; and the public headers on their
+// own. An API change that breaks a plugin breaks this test first.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -49,14 +50,16 @@ t::CommandResult configure(const fs::path& source, const fs::path& build, const 
   return run(TSI_TEST_CMAKE, args);
 }
 
-/// Relative error at T = 1 of one SE1 run of the fput model with the installed runner.
-double se1_error(const std::string& tsi, const t::TempDir& dir, double eps, long steps,
-                 const std::vector<std::string>& plugin_args, const t::CommandEnv& env) {
-  const Json config = {{"model", {{"name", "fput"}, {"eps", eps}}},
-                       {"scheme", {{"name", "se1"}, {"tol", 1e-12}}},
+/// Relative error at T = 1 of one run of `model` with `scheme` and `steps` steps, with the
+/// installed runner, against its reference (tol 1e-12).
+double run_error(const std::string& tsi, const t::TempDir& dir, const std::string& model, double eps,
+                 const std::string& scheme, long steps, const std::vector<std::string>& plugin_args,
+                 const t::CommandEnv& env = {}) {
+  const Json config = {{"model", {{"name", model}, {"eps", eps}}},
+                       {"scheme", {{"name", scheme}}},
                        {"time", {{"h", 1.0 / static_cast<double>(steps)}, {"t_end", 1.0}}},
                        {"reference", {{"tol", 1e-12}}}};
-  const std::string name = "fput-" + std::to_string(eps) + "-" + std::to_string(steps);
+  const std::string name = model + "-" + scheme + "-" + std::to_string(eps) + "-" + std::to_string(steps);
   const std::string file = t::write_config(dir, config, name + ".json");
   std::vector<std::string> args = plugin_args;
   for (const char* a : {"run", file.c_str()}) args.emplace_back(a);
@@ -67,15 +70,59 @@ double se1_error(const std::string& tsi, const t::TempDir& dir, double eps, long
   REQUIRE(r.exit_code == 0);
   const Json result = t::read_json(dir.path() / name / "result.json");
   REQUIRE(result.at("status") == "completed");
-  CHECK(mentions(result.at("config").at("model").at("name").get<std::string>(), "fput"));
+  CHECK(result.at("config").at("model").at("name") == model);
+  CHECK(result.at("config").at("scheme").at("name") == scheme);
   return result.at("error").at("relative").get<double>();
+}
+
+/// The errors of run_error at h = 1/4 .. 1/32 (T = 1) and their least-squares order.
+struct Series {
+  std::vector<double> errors;
+  double order = 0.0;
+};
+Series error_series(const std::string& tsi, const t::TempDir& dir, const std::string& model, double eps,
+                    const std::string& scheme, const std::vector<std::string>& plugin_args,
+                    const t::CommandEnv& env = {}) {
+  Series s;
+  std::vector<double> hs;
+  for (long n : {4L, 8L, 16L, 32L}) {
+    hs.push_back(1.0 / static_cast<double>(n));
+    s.errors.push_back(run_error(tsi, dir, model, eps, scheme, n, plugin_args, env));
+  }
+  s.order = tsi::least_squares_order(hs, s.errors);
+  return s;
+}
+
+/// Configures and builds the example project `source` (an installed example's directory) in
+/// `build` against `prefix`, and returns the plugin it made, build/tsi_<name>.so.
+fs::path build_example(const fs::path& source, const fs::path& build, const fs::path& prefix,
+                       const std::string& name) {
+  const t::CommandResult r = configure(source, build, prefix);
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  const t::CommandResult b = run(TSI_TEST_CMAKE, {"--build", build.string()});
+  INFO(b.describe());
+  REQUIRE(b.exit_code == 0);
+  const fs::path plugin = build / ("tsi_" + name + ".so");
+  REQUIRE(fs::exists(plugin));
+  return plugin;
+}
+
+/// The example's own ctest: `tsi check` of the installed runner on the plugin.
+void check_example(const fs::path& build, const std::string& passed) {
+  const t::CommandResult r = run(TSI_TEST_CTEST, {"--test-dir", build.string(), "-V"});
+  INFO(r.describe());
+  CHECK(r.exit_code == 0);
+  CHECK(mentions(r.out, passed));
+  CHECK(mentions(r.out, "checks passed"));
 }
 
 }  // namespace
 
-TEST_CASE("sdk: an out-of-tree model plugin builds against an installed tsi and runs") {
+TEST_CASE("sdk: the installed example plugins build against an installed tsi and run") {
   t::TempDir tmp("tsi-sdk-test");
   const fs::path prefix = tmp.path() / "prefix", build = tmp.path() / "fput-build";
+  const fs::path examples = prefix / "share/tsi/examples/plugins";
 
   // 1. Install: the runner, the core, the shipped plugins, the headers, the CMake package.
   {
@@ -89,7 +136,11 @@ TEST_CASE("sdk: an out-of-tree model plugin builds against an installed tsi and 
         "lib/tsi/plugins/tsi_rk78.so", "include/tsi/model.hpp", "include/tsi/plugin.hpp",
         "lib/cmake/tsi/tsiConfig.cmake", "lib/cmake/tsi/tsiConfigVersion.cmake",
         "lib/cmake/tsi/tsiTargets.cmake", "lib/cmake/tsi/TsiPlugin.cmake", "include/tsi/assembly.hpp",
-        "include/tsi/algebra.hpp", "include/tsi/model_checks.hpp", "share/doc/tsi/SPEC.md", "share/doc/tsi/writing-a-model.md"}) {
+        "include/tsi/algebra.hpp", "include/tsi/model_checks.hpp", "share/doc/tsi/SPEC.md", "share/doc/tsi/writing-a-model.md",
+        "share/tsi/examples/plugins/fput/CMakeLists.txt", "share/tsi/examples/plugins/fput/fput.cpp",
+        "share/tsi/examples/plugins/expmid/CMakeLists.txt", "share/tsi/examples/plugins/expmid/expmid.cpp",
+        "share/tsi/examples/plugins/van_der_pol/CMakeLists.txt", "share/tsi/examples/plugins/van_der_pol/van_der_pol.cpp",
+        "share/tsi/examples/plugins/van_der_pol/van-der-pol-se1.json"}) {
     CHECK_MESSAGE(fs::exists(prefix / file), "not installed: " << file);
   }
   CHECK_FALSE(fs::exists(prefix / "lib/tsi/plugins/tsi_fixture_good.so"));  // test fixtures stay out
@@ -111,35 +162,25 @@ TEST_CASE("sdk: an out-of-tree model plugin builds against an installed tsi and 
     CHECK(found);
   }
 
-  // 3. The example builds from its own directory against the prefix alone.
-  {
-    const t::CommandResult r =
-        configure(fs::path(TSI_TEST_SOURCE_DIR) / "examples/plugins/fput", build, prefix);
-    INFO(r.describe());
-    REQUIRE(r.exit_code == 0);
-    const t::CommandResult b = run(TSI_TEST_CMAKE, {"--build", build.string()});
-    INFO(b.describe());
-    REQUIRE(b.exit_code == 0);
-  }
-  const fs::path plugin = build / "tsi_fput.so";
-  REQUIRE(fs::exists(plugin));
+  // 3. The Hamiltonian example builds from the prefix's copy against the prefix alone.
+  const fs::path plugin = build_example(examples / "fput", build, prefix, "fput");
   const std::string plugin_path = fs::canonical(plugin).string();
 
-  // 4. `tsi list` shows the external model and the file that provided it.
+  // 4. `tsi list` shows the external model, the file that provided it, and marks it as the
+  //    --plugin file's (the shipped models stay unmarked).
   {
     const t::CommandResult r = run(tsi, {"--plugin", plugin.string(), "list", "models"});
     INFO(r.describe());
     REQUIRE(r.exit_code == 0);
     CHECK(mentions(r.out, "fput (fpu, fermi-pasta-ulam)"));
+    CHECK(mentions(r.out, "dim 4m  [from tsi_fput.so]\n"));
     CHECK(mentions(r.out, "provided by " + plugin_path));
     CHECK(mentions(r.out, "default n_tau 64"));
+    CHECK(r.out.find("[from") == r.out.rfind("[from"));  // one marked entry
   }
 
   // 5. Observed order 2 with SE1 at two values of eps: h = 1/4 .. 1/32 at T = 1, against the
   //    rk78 reference on the filtered problem; loaded with --plugin, then with TSI_PLUGIN_PATH.
-  const std::vector<long> steps = {4, 8, 16, 32};
-  std::vector<double> hs;
-  for (long n : steps) hs.push_back(1.0 / static_cast<double>(n));
   t::CommandEnv by_path;
   by_path.set["TSI_PLUGIN_PATH"] = build.string();
   const struct {
@@ -148,53 +189,62 @@ TEST_CASE("sdk: an out-of-tree model plugin builds against an installed tsi and 
     t::CommandEnv env;
   } series[] = {{1e-2, {"--plugin", plugin.string()}, {}}, {1e-4, {}, by_path}};
   for (const auto& s : series) {
-    std::vector<double> errors;
-    for (long n : steps) errors.push_back(se1_error(tsi, tmp, s.eps, n, s.plugin_args, s.env));
-    const double order = tsi::least_squares_order(hs, errors);
+    const Series fput = error_series(tsi, tmp, "fput", s.eps, "se1", s.plugin_args, s.env);
     CAPTURE(s.eps);
-    CAPTURE(errors[0]);
-    CAPTURE(errors[3]);
-    CHECK(std::abs(order - 2.0) <= 0.2);
-    CHECK(errors[3] < 1e-3);
+    CAPTURE(fput.errors[0]);
+    CAPTURE(fput.errors[3]);
+    CHECK(std::abs(fput.order - 2.0) <= 0.2);  // measured 1.93 (eps = 1e-2), 1.97 (1e-4)
+    CHECK(fput.errors[3] < 1e-3);              // measured 4.9e-4, 5.6e-4
   }
 
   // 6. The plugin passes the conformance checks, run by the example's own ctest (tsi::tsi).
-  {
-    const t::CommandResult r = run(TSI_TEST_CTEST, {"--test-dir", build.string(), "-V"});
-    INFO(r.describe());
-    CHECK(r.exit_code == 0);
-    CHECK(mentions(r.out, "fput: all"));
-    CHECK(mentions(r.out, "checks passed"));
-  }
+  check_example(build, "fput: all");
 
-  // 7. A scheme plugin (docs/writing-a-scheme.md) builds the same way and passes its checks
-  //    on the shipped Henon-Heiles model, then runs from a config.
+  // 7. The scheme example (docs/writing-a-scheme.md) builds the same way, passes its checks on
+  //    the shipped Henon-Heiles model, and is second order there at eps = 1e-4 (away from the
+  //    step-size resonances h = k pi eps, where it loses an order).
   {
     const fs::path scheme_build = tmp.path() / "expmid-build";
-    const t::CommandResult r =
-        configure(fs::path(TSI_TEST_SOURCE_DIR) / "examples/plugins/expmid", scheme_build, prefix);
-    INFO(r.describe());
-    REQUIRE(r.exit_code == 0);
-    const t::CommandResult b = run(TSI_TEST_CMAKE, {"--build", scheme_build.string()});
-    INFO(b.describe());
-    REQUIRE(b.exit_code == 0);
-    const t::CommandResult c = run(TSI_TEST_CTEST, {"--test-dir", scheme_build.string(), "-V"});
-    INFO(c.describe());
-    CHECK(c.exit_code == 0);
-    CHECK(mentions(c.out, "exp-midpoint"));
-    CHECK(mentions(c.out, "henon-heiles: all"));
-    const Json config = {{"model", {{"name", "henon-heiles"}, {"eps", 1e-4}}},
-                         {"scheme", {{"name", "emp"}}},
-                         {"time", {{"h", 0.125}, {"t_end", 1.0}}}};
-    const t::CommandResult e = run(tsi, {"--plugin", (scheme_build / "tsi_expmid.so").string(), "run",
-                                         t::write_config(tmp, config, "emp.json"), "--out", tmp / "emp"});
-    INFO(e.describe());
-    CHECK(e.exit_code == 0);
-    CHECK(t::read_json(tmp.path() / "emp" / "result.json").at("config").at("scheme").at("name") ==
-          "exp-midpoint");
+    const fs::path scheme = build_example(examples / "expmid", scheme_build, prefix, "expmid");
+    check_example(scheme_build, "henon-heiles: all");
+    const Series emp = error_series(tsi, tmp, "henon-heiles", 1e-4, "exp-midpoint", {"--plugin", scheme.string()});
+    CAPTURE(emp.errors[0]);
+    CAPTURE(emp.errors[3]);
+    CHECK(std::abs(emp.order - 2.0) <= 0.2);  // measured 2.00
+    CHECK(emp.errors[3] < 2e-4);              // measured 7.7e-5
   }
 
-  // 8. The public headers are the whole interface: all of them in one translation unit built
+  // 8. The general-class example (no Hamiltonian structure) builds the same way, passes its
+  //    checks, runs its own installed config without energies, and is uniformly second order
+  //    with SE1: the same errors at eps = 1e-4 and 1e-5.
+  {
+    const fs::path general_build = tmp.path() / "van-der-pol-build";
+    const fs::path general = build_example(examples / "van_der_pol", general_build, prefix, "van_der_pol");
+    check_example(general_build, "van-der-pol: all");
+    const std::vector<std::string> plugin_args = {"--plugin", general.string()};
+
+    std::vector<std::string> args = plugin_args;
+    args.insert(args.end(), {"run", (examples / "van_der_pol/van-der-pol-se1.json").string(), "--out",
+                             (tmp.path() / "vdp-example").string()});
+    const t::CommandResult e = run(tsi, args);
+    INFO(e.describe());
+    REQUIRE(e.exit_code == 0);
+    const Json result = t::read_json(tmp.path() / "vdp-example" / "result.json");
+    CHECK(result.at("status") == "completed");
+    CHECK(result.at("error").at("relative").get<double>() < 2e-4);  // measured 8.1e-5 (eps 1e-4, h 1/16)
+    CHECK_FALSE(result.value("invariants", Json::object()).contains("H"));  // no energy without the structure
+
+    const Series at_4 = error_series(tsi, tmp, "van-der-pol", 1e-4, "se1", plugin_args);
+    const Series at_5 = error_series(tsi, tmp, "van-der-pol", 1e-5, "se1", plugin_args);
+    CAPTURE(at_4.errors[3]);
+    CAPTURE(at_5.errors[3]);
+    CHECK(std::abs(at_4.order - 2.0) <= 0.2);  // measured 2.01
+    CHECK(std::abs(at_5.order - 2.0) <= 0.2);  // measured 2.01
+    CHECK(at_4.errors[3] < 1e-4);              // measured 2.0e-5
+    CHECK(std::abs(at_4.errors[3] / at_5.errors[3] - 1.0) < 0.05);  // measured 0.6 %
+  }
+
+  // 9. The public headers are the whole interface: all of them in one translation unit built
   //    against the prefix, linked against tsi::core; and the package's version check.
   {
     const fs::path consumer = fs::path(TSI_TEST_SOURCE_DIR) / "tests/sdk/consumer";

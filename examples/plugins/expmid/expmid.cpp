@@ -16,22 +16,23 @@
 namespace {
 
 using tsi::Complex;
+using tsi::Real;
 using tsi::Vector;
 
 class ExpMidpoint final : public tsi::Stepper {
  public:
   // Bound to one problem and step size h: e^{z/2}, (h/2) phi1(z/2), e^z, h phi1(z) for every
   // entry of L's diagonal, computed here once, and the work vectors from the problem's prototype.
-  ExpMidpoint(tsi::Problem& problem, double h, std::monostate)
+  ExpMidpoint(tsi::Problem& problem, Real h, std::monostate)
       : Stepper(problem, h), n_(problem.new_state()), stage_(problem.new_state()) {
     const tsi::Diagonal& lambda = problem.linear_multipliers();
     tsi::diagonal_function(lambda, 0.5 * h, [](Complex z) { return std::exp(z); }, e_half_);
-    tsi::diagonal_function(lambda, 0.5 * h, [h](Complex z) { return 0.5 * h * tsi::phi1(z); }, b_half_);
+    tsi::diagonal_function(lambda, 0.5 * h, [h](Complex z) { return Real(0.5) * h * tsi::phi1(z); }, b_half_);
     tsi::diagonal_function(lambda, h, [](Complex z) { return std::exp(z); }, e_full_);
     tsi::diagonal_function(lambda, h, [h](Complex z) { return h * tsi::phi1(z); }, b_full_);
   }
 
-  void step(double t, Vector& y) override {
+  void step(Real t, Vector& y) override {
     problem_.nonlinear(t, y, n_);
     tsi::algebra::diagonal_combination(e_half_, y, b_half_, n_, stage_);
     problem_.nonlinear(t + 0.5 * h_, stage_, n_);

@@ -33,12 +33,13 @@ using tsi::Complex;
 using tsi::ConstMatrixRef;
 using tsi::Index;
 using tsi::MatrixRef;
+using tsi::Real;
 using tsi::Vector;
 
 // Hamiltonian (energies are reported), with its own physical variables.
 class Fput final : public tsi::Model, public tsi::HamiltonianStructure, public tsi::PhysicalVariables {
  public:
-  Fput(double eps, Index m) : Model(eps), m_(m), root_eps_(std::sqrt(eps)) {}
+  Fput(Real eps, Index m) : Model(eps), m_(m), root_eps_(std::sqrt(eps)) {}
 
   const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
   const tsi::PhysicalVariables* physical_variables() const override { return this; }
@@ -49,7 +50,7 @@ class Fput final : public tsi::Model, public tsi::HamiltonianStructure, public t
   // e^{JM tau}: xi' = eta, eta' = -xi in tau, a rotation of every stiff pair.
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
     for (Index j = 0; j < u.cols(); ++j) {
-      const double c = std::cos(taus(j)), s = std::sin(taus(j));
+      const Real c = std::cos(taus(j)), s = std::sin(taus(j));
       for (Index i = 0; i < m_; ++i) {
         const Complex xi = u(m_ + i, j), eta = u(3 * m_ + i, j);
         u(m_ + i, j) = c * xi + s * eta;
@@ -76,7 +77,7 @@ class Fput final : public tsi::Model, public tsi::HamiltonianStructure, public t
       out.col(j).setZero();
       for (Index k = 0; k <= m_; ++k) {
         const Complex d = spring(u.col(j), k), dz = spring(z.col(j), k);
-        add_spring_force(k, 3.0 * d * d * dz, out.col(j));
+        add_spring_force(k, Real(3) * d * d * dz, out.col(j));
       }
       out.col(j).segment(0, m_) = z.col(j).segment(2 * m_, m_);
     }
@@ -94,8 +95,8 @@ class Fput final : public tsi::Model, public tsi::HamiltonianStructure, public t
     out.tail(2 * m_) = -u.head(2 * m_);
   }
 
-  double H1(const Vector& u) const override {
-    double soft = 0.0;
+  Real H1(const Vector& u) const override {
+    Real soft = 0;
     for (Index k = 0; k <= m_; ++k) soft += std::pow(spring(u, k).real(), 4);
     return 0.5 * u.segment(2 * m_, m_).real().squaredNorm() + 0.25 * soft;
   }
@@ -132,7 +133,7 @@ class Fput final : public tsi::Model, public tsi::HamiltonianStructure, public t
   // so it also gives the directional derivative a_k . z when applied to z.
   template <class Column>
   Complex spring(const Column& u, Index k) const {
-    Complex d = 0.0;
+    Complex d(0);
     if (k < m_) d += u(k) - root_eps_ * u(m_ + k);
     if (k > 0) d -= u(k - 1) + root_eps_ * u(m_ + k - 1);
     return d;
@@ -153,7 +154,7 @@ class Fput final : public tsi::Model, public tsi::HamiltonianStructure, public t
   }
 
   Index m_;
-  double root_eps_;
+  Real root_eps_;
 };
 
 void register_fput(tsi::Registry& registry) {
