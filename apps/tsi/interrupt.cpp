@@ -1,22 +1,19 @@
 #include "interrupt.hpp"
 
-#include <atomic>
 #include <csignal>
+
+#include "tsi/stop_request.hpp"
 
 namespace tsi::app {
 namespace {
 
-// Lock-free, so that the signal handler may set it and worker threads read it.
-std::atomic<int> received{0};
-static_assert(std::atomic<int>::is_always_lock_free);
-
 extern "C" void on_signal(int signal) {
-  if (received.load() != 0) {  // the second one: the default action (terminate)
+  if (tsi::stop_signal() != 0) {  // the second one: the default action (terminate)
     std::signal(signal, SIG_DFL);
     std::raise(signal);
     return;
   }
-  received.store(signal);
+  tsi::request_stop(signal);  // the core's flag: its long set-ups poll it too
 }
 
 }  // namespace
@@ -26,10 +23,10 @@ void install_interrupt_handlers() {
   std::signal(SIGTERM, on_signal);
 }
 
-int interrupt_signal() { return received.load(); }
+int interrupt_signal() { return tsi::stop_signal(); }
 
-void request_interrupt(int signal) { received.store(signal); }
+void request_interrupt(int signal) { tsi::request_stop(signal); }
 
-void clear_interrupt() { received.store(0); }
+void clear_interrupt() { tsi::clear_stop_request(); }
 
 }  // namespace tsi::app

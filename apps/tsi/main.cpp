@@ -32,6 +32,7 @@
 #include "study_distributed.hpp"
 #include "summary.hpp"
 #include "tsi/error.hpp"
+#include "tsi/stop_request.hpp"
 #include "tsi/fft.hpp"
 #include "tsi/context.hpp"
 #include "tsi/version.hpp"
@@ -251,6 +252,9 @@ int main(int argc, char** argv) {
       return 128 + tsi::app::interrupt_signal();
     }
     return rc;
+  } catch (const tsi::Interrupted& e) {  // a stop asked for during a set-up: nothing computed yet
+    spdlog::error("{}", e.what());
+    return 128 + e.signal();
   } catch (const tsi::IoError& e) {  // an output could not be written: not the input's fault
     spdlog::error("{}", e.what());
     return 3;
