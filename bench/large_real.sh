@@ -2,7 +2,7 @@
 # A real model with 10^7 unknowns on one machine: the synthetic Henon-Heiles ensemble
 # (bench/plugins/henon_heiles_ensemble.cpp; COPIES systems, dim 4 COPIES) on its two-scale
 # problem with SE1 and eab, STEPS steps, no reference; peak memory and wall time per step from
-# each run's result.json. Numbers for the README and docs/scaling.md.
+# each run's result.json. Numbers for the README and docs/benchmarks/memory.md.
 #   bench/large_real.sh [COPIES] [N_TAU] [STEPS] [OUT]
 # SCHEMES (default "se1 eab") and LAYOUTS (default "true false": reformulation.real_layout)
 # select the runs.

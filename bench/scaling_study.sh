@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Wall time (whole process) of one study (default: bench/studies/hh-scaling-480.json) with
 # --jobs 1 and 2 and under mpirun -np 1 and 2, REPS rounds (the best of each is kept), with its table checked against
-# the --jobs 1 table (timings aside). Numbers for docs/scaling.md.
+# the --jobs 1 table (timings aside). Numbers for docs/benchmarks/studies-over-ranks.md.
 #   bench/scaling_study.sh [STUDY.json] [REPS] [OUT]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"

@@ -41,6 +41,8 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/plugins/ DESTINATION ${CMAKE_IN
         REGEX "/build[^/]*$" EXCLUDE)
 # The documents a plugin author works from, next to the headers they describe: the formulas
 # and numbers (SPEC.md), writing a model or a scheme, and the plugin ABI.
-install(FILES ${PROJECT_SOURCE_DIR}/docs/SPEC.md ${PROJECT_SOURCE_DIR}/docs/writing-a-model.md
-              ${PROJECT_SOURCE_DIR}/docs/writing-a-scheme.md ${PROJECT_SOURCE_DIR}/docs/plugin-abi.md
+install(FILES ${PROJECT_SOURCE_DIR}/docs/SPEC.md ${PROJECT_SOURCE_DIR}/docs/explanation/model-interface.md
+              ${PROJECT_SOURCE_DIR}/docs/explanation/scheme-interface.md
+              ${PROJECT_SOURCE_DIR}/docs/tutorials/model-plugin.md ${PROJECT_SOURCE_DIR}/docs/tutorials/scheme-plugin.md
+              ${PROJECT_SOURCE_DIR}/docs/reference/plugin-abi.md
         DESTINATION ${CMAKE_INSTALL_DOCDIR})

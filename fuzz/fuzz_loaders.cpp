@@ -58,7 +58,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (const tsi::Error&) {
   }
   try {  // as `tsi study` reads it
-    (void)tsi::app::expand_study(raw, reg, overrides);
+    (void)tsi::app::expand_study(raw, reg, overrides, {}, {}, false);  // the loaders only: no model is built
   } catch (const tsi::Error&) {
   }
   return 0;

@@ -142,6 +142,30 @@ const ParamSchema& monitor_schema() {
 
 }  // namespace
 
+std::vector<RunnerSection> runner_sections() {
+  const std::vector<RunnerSection> all = {
+      {"model", "the model: \"name\" (required) a registered model or alias, then its parameters", nullptr, "models"},
+      {"reformulation",
+       "the problem the scheme integrates: \"name\" (default two-scale where the scheme supports it, else the "
+       "first it supports), then its parameters",
+       nullptr, "reformulations"},
+      {"scheme", "the scheme: \"name\" (default se1), then its parameters", nullptr, "schemes"},
+      {"time", "the step and the final time", &time_schema(), ""},
+      {"reference",
+       "absent: no error is computed; {} asks for the default reference solution, against which the error of "
+       "u(t_end) is measured",
+       &reference_schema(), ""},
+      {"output", "what is recorded and written while the run goes", &output_schema(), ""},
+      {"monitor", "when the run warns or stops", &monitor_schema(), ""},
+      {"plugins", "plugin files to load (a list of file names, relative to the config file; default [])", nullptr,
+       ""}};
+  // every section the resolver accepts is described, and nothing else
+  std::vector<std::string> names;
+  for (const auto& s : all) names.push_back(s.name);
+  if (names != sections) throw Error("runner_sections: out of step with the config's sections");
+  return all;
+}
+
 Json parse_json(std::istream& in, const std::string& origin) {
   // The parser's callback sees every key and nesting level: a duplicated key (which the parser
   // would silently resolve to the last value) and nesting deeper than any config needs are

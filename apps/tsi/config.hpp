@@ -2,6 +2,7 @@
 #include <cstddef>
 #include <istream>
 #include <string>
+#include <vector>
 
 #include "tsi/params.hpp"
 #include "tsi/registry.hpp"
@@ -46,6 +47,19 @@ Json resolve_run_config(const Json& raw, const Registry& registry);
 /// The model, reformulation and scheme of a resolved run config, as the core's assembler takes
 /// them (tsi::assemble).
 ResolvedSelection resolved_selection(const Json& resolved);
+
+/// A top-level section of a run config, as `tsi list config` shows it: the runner's own
+/// sections carry their parameter schema; model, reformulation and scheme name a registered
+/// entry (`chosen_from`) whose parameters come with it; plugins is a list of files.
+struct RunnerSection {
+  std::string name;
+  std::string summary;
+  const ParamSchema* params = nullptr;  ///< the runner's own sections (time, reference, output, monitor)
+  std::string chosen_from;              ///< the registry kind its "name" names, or empty
+};
+
+/// Every top-level section of a run config, in the order `tsi list config` shows them.
+std::vector<RunnerSection> runner_sections();
 
 /// Number of steps t_end / h (t_end must be a whole number of steps).
 long step_count(const Json& resolved);

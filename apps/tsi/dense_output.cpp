@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "tsi/phase.hpp"
+#include "tsi/stop_request.hpp"
 
 namespace tsi::app {
 
@@ -33,7 +34,10 @@ void DenseOutput::observe(long n, const Vector& y) {
   // the lasts), and n is below every later one's last: n is needed when the next one reaches it.
   if (next_ == pending_.size() || n < pending_[next_].first) return;
   states_[n] = y;
-  for (; next_ < pending_.size() && pending_[next_].last <= n; ++next_) evaluate(pending_[next_], n);
+  // Many times may fall in one step's reach: an interrupt stops their evaluation (the run then
+  // stops at this step, and the times left are reported as not reached).
+  for (; next_ < pending_.size() && pending_[next_].last <= n && !stop_requested(); ++next_)
+    evaluate(pending_[next_], n);
   // Steps no pending stencil reaches back to are dropped.
   const long keep_from = next_ == pending_.size() ? n + 1 : pending_[next_].first;
   states_.erase(states_.begin(), states_.lower_bound(keep_from));
@@ -41,7 +45,7 @@ void DenseOutput::observe(long n, const Vector& y) {
 
 void DenseOutput::finish() {
   const long last = last_observed_;
-  for (; next_ < pending_.size(); ++next_) {
+  for (; next_ < pending_.size() && !stop_requested(); ++next_) {
     const Pending& p = pending_[next_];
     if (last >= 0 && times_[p.index] <= step_time(last, h_) && p.first <= last) evaluate(p, last);
   }

@@ -25,7 +25,8 @@ class DenseOutput {
   void observe(long n, const Vector& y);
   /// The run stopped (at its end, a blow-up or an interrupt) after the last step observed:
   /// the times it reached are evaluated with the steps of their stencil that were computed
-  /// (a lower degree); the others stay unset.
+  /// (a lower degree); the others stay unset. An interrupt (tsi::stop_requested) stops the
+  /// evaluations within one of them, here and in observe: the times left stay unset.
   void finish();
 
   const std::vector<double>& times() const { return times_; }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "config.hpp"
 #include "tsi/error.hpp"
 
 namespace tsi::app {
@@ -43,14 +44,31 @@ Json info_json(const EntryInfo& info, const std::vector<std::string>& marked) {
 }
 
 void check_what(const std::string& what) {
-  if (!what.empty() && what != "models" && what != "reformulations" && what != "schemes" && what != "fields")
-    throw ConfigError("list", "got \"" + what + "\", expected models, reformulations, schemes or fields");
+  if (!what.empty() && what != "models" && what != "reformulations" && what != "schemes" && what != "fields" &&
+      what != "config")
+    throw ConfigError("list", "got \"" + what +
+                                  "\", expected models, reformulations, schemes or fields (or config: the run "
+                                  "config's sections and keys)");
+}
+
+/// The run config's sections (`tsi list config`): not part of the default listing, which is
+/// what the registry holds.
+Json config_json() {
+  Json out = Json::array();
+  for (const auto& section : runner_sections()) {
+    Json j = {{"name", section.name}, {"summary", section.summary}};
+    if (section.params) j["params"] = params_json(*section.params);
+    if (!section.chosen_from.empty()) j["chosen_from"] = section.chosen_from;
+    out.push_back(j);
+  }
+  return out;
 }
 
 }  // namespace
 
 Json list_json(const Registry& registry, const std::string& what, const std::vector<std::string>& given_plugins) {
   check_what(what);
+  if (what == "config") return {{"config", config_json()}};
   const std::vector<std::string> marked = canonical_providers(given_plugins);
   Json out = Json::object();
   if (what.empty() || what == "models") {
@@ -97,6 +115,21 @@ Json list_json(const Registry& registry, const std::string& what, const std::vec
 std::string list_text(const Registry& registry, const std::string& what, const std::vector<std::string>& given_plugins) {
   const Json all = list_json(registry, what, given_plugins);
   std::string s;
+  if (all.contains("config")) {
+    s += "config:\n";
+    for (const auto& section : all["config"]) {
+      s += fmt::format("  {}  {}{}\n", section["name"].get<std::string>(), section["summary"].get<std::string>(),
+                       section.contains("chosen_from")
+                           ? " (tsi list " + section["chosen_from"].get<std::string>() + ")"
+                           : "");
+      for (const auto& p : section.value("params", Json::array()))
+        s += fmt::format("      {:<24} {:<10} default {:<8} {}{}\n", p["name"].get<std::string>(),
+                         p["type"].get<std::string>(), p["default"].is_null() ? "-" : p["default"].dump(),
+                         p["description"].get<std::string>(),
+                         p["expected"].get<std::string>().empty() ? "" : " [" + p["expected"].get<std::string>() + "]");
+    }
+    return s;
+  }
   for (const char* kind : {"models", "reformulations", "schemes", "fields"}) {
     if (!all.contains(kind)) continue;
     s += fmt::format("{}{}:\n", s.empty() ? "" : "\n", kind);

@@ -119,7 +119,9 @@ int main(int argc, char** argv) {
   auto* list = app.add_subcommand("list", "list registered models, reformulations, schemes and fields (those of --plugin FILE marked)");
   std::string what;
   bool as_json = false;
-  list->add_option("what", what, "models, reformulations, schemes or fields (default: all)");
+  list->add_option("what", what,
+                   "models, reformulations, schemes or fields (default: all four); config: the run config's "
+                   "sections and keys");
   list->add_flag("--json", as_json, "print JSON");
 
   auto* run = app.add_subcommand("run", "run one config and write result.json and invariants.csv");

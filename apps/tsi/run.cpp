@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <optional>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -21,6 +22,7 @@
 #include "tsi/phase.hpp"
 #include "tsi/driver.hpp"
 #include "tsi/error.hpp"
+#include "tsi/stop_request.hpp"
 #include "tsi/npy.hpp"
 #include "tsi/output.hpp"
 #include "tsi/version.hpp"
@@ -149,12 +151,33 @@ std::shared_ptr<const Model> model_with_exact_solution(const Json& config, const
   return model;
 }
 
+// A model's exact solution starts from its own data (nls and klein-gordon: the plane wave of
+// model.initial): a run from another model.u0 has none, refused before the run, not after it.
+void check_exact_start(const Json& config, const Model& model) {
+  const Json& section = config["model"];
+  if (!section.contains("u0") || section["u0"].is_null()) return;
+  const Vector x0 = model.to_physical(initial_value(model, without_name(section)));
+  try {
+    (void)model.exact_solution()->at(x0, 0.0);
+  } catch (const ConfigError&) {
+    throw;
+  } catch (const Error& e) {
+    const Json& u0 = section["u0"];
+    throw ConfigError("model.u0",
+                      fmt::format("got {}, but reference.scheme is \"{}\": {}; leave model.u0 out (the model's own "
+                                  "data, e.g. model.initial \"plane-wave\", are then the initial value), or choose a "
+                                  "reference solver, e.g. \"rk78\"",
+                                  u0.is_string() ? "the file " + u0.dump() : fmt::format("{} values", u0.size()),
+                                  exact_reference, e.what()));
+  }
+}
+
 }  // namespace
 
 void check_reference_cost(const Json& config, const Registry& registry, const RunSettings& settings) {
   const Json& ref = config["reference"];
   if (ref["scheme"] == exact_reference) {
-    model_with_exact_solution(config, registry, settings);
+    check_exact_start(config, *model_with_exact_solution(config, registry, settings));
     return;
   }
   const Json scheme_section =
@@ -295,7 +318,11 @@ std::vector<std::uint64_t> state_shape(const Json& config, const Model& model, I
 // where the run did not reach it) inline up to max_inline_state values in all, else where
 // u_times.npy holds them (NaN where not reached).
 Json dense_output_entry(const DenseOutput& dense, const RunOutcome& outcome) {
-  Json entry = {{"times", dense.times()}, {"degree", dense.degree()}};
+  // How many were evaluated: the others (past where the run stopped, or left by an interrupt)
+  // are null here and NaN in u_times.npy.
+  const auto evaluated = std::count_if(dense.values().begin(), dense.values().end(),
+                                       [](const Vector& u) { return u.size() > 0; });
+  Json entry = {{"times", dense.times()}, {"degree", dense.degree()}, {"evaluated", evaluated}};
   std::uint64_t per_time = 1;
   for (const std::uint64_t d : outcome.state_shape) per_time *= d;
   if (per_time * dense.times().size() > static_cast<std::uint64_t>(max_inline_state)) {
@@ -455,6 +482,32 @@ void agree_to_start(const Collective& split, const Json& config, const Registry&
 
 namespace {
 
+// Where a run's initial value comes from, for a refusal of it: the field the user gave it by
+// (model.u0; else the model's data parameter given: a particle file, z0 and eps_z_t0, a plane
+// wave's amplitude; else the model's own data), "got VALUE: " where the value is short, what it
+// gives ("from model.z0 and model.eps_z_t0") and what to change.
+struct InitialValueSource {
+  std::string field = "model.name", got, gives = "(the model's own data)", remedy;
+};
+
+InitialValueSource initial_value_source(const Json& model) {
+  const auto given = [&](const char* key) { return model.contains(key) && !model[key].is_null(); };
+  InitialValueSource source;
+  std::vector<std::string> fields;
+  if (given("u0")) fields.push_back("u0");
+  if (given("particles") && model["particles"].is_string()) fields.push_back("particles");
+  for (const char* key : {"z0", "eps_z_t0", "amplitude"})
+    if (given(key)) fields.push_back(key);
+  if (fields.empty()) return source;
+  const Json& first = model[fields.front()];
+  source.field = "model." + fields.front();
+  if (first.is_number() || first.is_string()) source.got = "got " + first.dump() + ": ";
+  for (std::string& f : fields) f = "model." + f;
+  source.gives = fmt::format("from {}", fmt::join(fields, " and "));
+  source.remedy = fields.front() == "model.amplitude" ? " (a smaller model.amplitude)" : " (smaller values)";
+  return source;
+}
+
 // output.times, checked: each in [0, t_end], and not with a re-prepared run.
 std::vector<double> checked_output_times(const Json& config) {
   std::vector<double> times;
@@ -483,6 +536,9 @@ RunPlan plan_run(const Json& config, const Registry& registry, const RunSettings
   // the data are prepared: the preparation's temporaries are gone by then.
   AssemblyOptions assembly_options;  // bound after the preparation (assembly.bind in execute_run)
   assembly_options.context = settings.context;
+  // Dense output keeps u at every output time until the run's end: counted before it starts.
+  assembly_options.kept_states = static_cast<double>(checked_output_times(config).size());
+  assembly_options.kept_states_field = "output.times";
   plan.assembly = assemble(resolved_selection(config), registry, assembly_options);
   Assembly& assembly = plan.assembly;
   // A reference that could not finish is refused now, not after the run.
@@ -492,15 +548,30 @@ RunPlan plan_run(const Json& config, const Registry& registry, const RunSettings
   const Model& model = *assembly.model;
   const Vector& u0 = assembly.u0;
   {  // an initial value whose invariants overflow (entries of 1e300) would only "blow up" at t = 0
+    const InitialValueSource source = initial_value_source(config["model"]);
     if (!u0.allFinite())
-      throw ConfigError("model.u0", "the initial value has non-finite entries; expected finite numbers");
+      throw ConfigError(source.field, fmt::format("{}the initial value {} has non-finite entries; expected finite "
+                                                  "numbers",
+                                                  source.got, source.gives));
     const bool hamiltonian = model.has_hamiltonian_structure();
     const Real H0 = hamiltonian ? model.energy(u0) : 0, I0 = hamiltonian ? model.oscillatory_energy(u0) : 0,
                m0 = hamiltonian ? model.mass(u0) : 0;
     if (!std::isfinite(H0) || !std::isfinite(I0) || !std::isfinite(m0))
-      throw ConfigError("model.u0", fmt::format("H = {}, I = {}, m = {} at the initial value; expected an initial "
-                                                "value whose invariants are finite numbers",
-                                                H0, I0, m0));
+      throw ConfigError(source.field, fmt::format("{}H = {}, I = {}, m = {} at the initial value {}; expected an "
+                                                  "initial value whose invariants are finite numbers{}",
+                                                  source.got, H0, I0, m0, source.gives, source.remedy));
+    // The model's own conserved invariants too (a particle energy sum w |v|^2 / 2 that overflows):
+    // else their monitors are NaN from the first step. Not in a split run, whose invariants are
+    // collective (its model checked its share's data when it was made).
+    if (!settings.context.collective)
+      for (const ModelInvariant& invariant : model.invariants()) {
+        const Real value = invariant.conserved ? invariant.value(u0) : Real(0);
+        if (!std::isfinite(value))
+          throw ConfigError(source.field, fmt::format("{}{} = {} at the initial value {} ({}); expected an initial "
+                                                      "value whose invariants are finite numbers{}",
+                                                      source.got, invariant.name, value, source.gives,
+                                                      invariant.description, source.remedy));
+      }
   }
 
   const auto& rconf = config["reformulation"];
@@ -546,6 +617,9 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
 
   const auto& rconf = config["reformulation"];
   const Collective* split = settings.context.collective;  // tsi run --split: this process's share
+  // Split over processes, the run stops where all agree (at a step's end), never one mid-step.
+  std::optional<StopPollsPaused> collective_stops;
+  if (split) collective_stops.emplace();
   const double h = config["time"]["h"], t_end = config["time"]["t_end"];
   const long n_steps = plan.steps;
   if (!stream_dir.empty()) {
@@ -633,6 +707,12 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
       status = recorder.status();
       outcome.message = recorder.message();
     }
+  } catch (const Interrupted& e) {  // within a step or the preparation: the steps made are kept
+    status = "interrupted";
+    outcome.message = fmt::format("interrupted by signal {} at t = {:.6g} (step {} of {}) {}", e.signal(),
+                                  step_time(recorder.steps(), h), recorder.steps(), n_steps,
+                                  recorder.steps() > 0 ? "during the next step" : "before the first step");
+    if (split) stop_split_run(*split, stream_dir, result, recorder, outcome.message, 1);
   } catch (const IoError& e) {  // the output failed (a full disk), not the computation
     status = "failed";
     outcome.io_error = e.what();

@@ -66,16 +66,11 @@ void write_run_files(const std::string& dir, const RunOutcome& outcome) {
     write_state_file(dir + "/" + reference_u_final_file, outcome.reference_u_final, outcome, reference_entry);
     if (!outcome.u_times.empty() && outcome.u_final.size() > 0) {  // u at output.times, one row per time
       const Index per_time = outcome.u_final.size();
-      Vector all(per_time * static_cast<Index>(outcome.u_times.size()));
-      for (size_t k = 0; k < outcome.u_times.size(); ++k)
-        all.segment(static_cast<Index>(k) * per_time, per_time) =
-            outcome.u_times[k].size() == per_time
-                ? outcome.u_times[k]
-                : Vector::Constant(per_time, Complex(std::numeric_limits<double>::quiet_NaN(), 0.0));
       std::vector<std::uint64_t> shape = {outcome.u_times.size()};
       const std::vector<std::uint64_t> one = one_state_shape(outcome, static_cast<std::uint64_t>(per_time));
       shape.insert(shape.end(), one.begin(), one.end());
-      write_npy(dir + "/" + u_times_file, all, outcome.complex_state, shape);
+      // Row by row (NaN where the run did not reach the time): no second copy of them all.
+      write_npy_rows(dir + "/" + u_times_file, outcome.u_times, per_time, outcome.complex_state, shape);
     }
   } catch (const IoError& e) {
     state_error = e.what();
@@ -87,13 +82,28 @@ void write_run_files(const std::string& dir, const RunOutcome& outcome) {
   }
   // result.json even when the rows are gone (the directory was removed mid-run): what the
   // run computed is in it.
-  if (state_error.empty()) {
-    write_file_atomically(dir + "/result.json", outcome.result.dump(2) + "\n");
-  } else {
-    Json result = outcome.result;
+  Json result = outcome.result;
+  if (!state_error.empty()) {
     result["status"] = "failed";
     result["message"] = state_error + (outcome.message.empty() ? "" : "; " + outcome.message);
+  }
+  try {
     write_file_atomically(dir + "/result.json", result.dump(2) + "\n");
+  } catch (const IoError& e) {
+    // A checkpoint's result.json ("running") must not outlive the run: a short record of the
+    // failure may still fit where the whole one did not; failing that, the stale one goes.
+    const Json failed = {{"status", "failed"},
+                         {"message", std::string(e.what()) + "; the run's own status: " +
+                                         result.value("status", std::string("unknown"))},
+                         {"t_reached", result.value("t_reached", Json())},
+                         {"steps", result.value("steps", Json())}};
+    try {
+      write_file_atomically(dir + "/result.json", failed.dump(2) + "\n");
+    } catch (const IoError&) {
+      std::error_code removed;
+      std::filesystem::remove(dir + "/result.json", removed);
+    }
+    throw;
   }
   if (ec) throw IoError("cannot rename " + outcome.csv_file + " to " + dir + "/invariants.csv: " + ec.message());
   if (!state_error.empty()) throw IoError(state_error);

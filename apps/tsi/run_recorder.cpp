@@ -210,12 +210,16 @@ bool RunRecorder::observe(long n, Real t, const Vector& y) {
   u_.swap(u);  // no copy of a state of 10^7 numbers
   steps_ = n;
   t_ = to_double(t);
+  std::string non_finite;  // a conserved invariant of the model that is no longer a number
   for (auto& d : declared_) {
     d.final = d.invariant.value(u_);
     d.change = to_double(std::abs(d.final - d.initial) / (d.relative ? std::abs(d.initial) : Real(1)));
-    d.max_change = std::max(d.max_change, d.change);
+    // std::max drops a NaN (inf - inf): kept, the record and the summary show nan, never 0.
+    d.max_change = std::isnan(d.change) ? d.change : std::max(d.max_change, d.change);
     d.min = std::min(d.min, d.final);
     d.max = std::max(d.max, d.final);
+    if (d.invariant.conserved && !std::isfinite(d.final) && non_finite.empty())
+      non_finite = fmt::format("{} = {}", d.invariant.name, to_double(d.final));
   }
   const bool blow_up = errors[0] > max_err_H_;
   if (n % every_ == 0 || n == n_steps_ || blow_up) {
@@ -238,6 +242,16 @@ bool RunRecorder::observe(long n, Real t, const Vector& y) {
     status_ = "blow-up";
     message_ = fmt::format("err_H = {:.3e} exceeded monitor.max_err_H = {:g} at t = {:.6g} (step {})",
                            errors[0], max_err_H_, t, n);
+    return false;
+  }
+  // A finite state whose conserved invariant overflowed (velocities near 1e154): its changes
+  // are NaN from here on, so the run stops as failed rather than report them. (A split run's
+  // invariants are sums over every process: all of them stop here alike.)
+  if (!non_finite.empty()) {
+    status_ = "blow-up";
+    message_ = fmt::format("the invariant {} at t = {:.6g} (step {}) is not a finite number: the state's values are "
+                           "too large for it to be monitored",
+                           non_finite, t, n);
     return false;
   }
   return true;

@@ -194,7 +194,7 @@ int merge_command(PluginLoader& loader, Registry& registry, const StudyCli& cli)
   const Json& spec = first.record["study"];
   if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
     load_config_plugins(loader, spec["base"]["plugins"], study_path);
-  const Study study = expand_study(spec, registry, {}, study_path);
+  const Study study = expand_study(spec, registry, {}, study_path, {}, false);  // the runs were built by the shards
   if (first.record.value("total_runs", size_t{0}) != study.runs.size())
     throw ConfigError("--merge", fmt::format("the shards were split from {} runs, the study now expands to {} (another "
                                              "tsi version, or changed plugins?)",

@@ -10,11 +10,20 @@
 #include "config.hpp"
 #include "run.hpp"
 #include "tsi/error.hpp"
+#include "tsi/stop_request.hpp"
 
 namespace tsi::app {
 namespace {
 
 const std::vector<std::string> kinds = {"convergence", "conservation", "work-precision"};
+
+// Plugins are loaded once, from base.plugins, before the study expands: a run's own list (a
+// path a vary, a case or a --set assigns) would never be loaded, so it is refused.
+void refuse_plugins_path(const std::string& path, const std::string& where) {
+  if (path == "plugins" || path.rfind("plugins.", 0) == 0 || path.rfind("plugins[", 0) == 0)
+    throw ConfigError(where, "plugins are loaded once for the whole study, before it expands: list them in "
+                             "base.plugins (or pass --plugin FILE), not per run");
+}
 
 // A "vary" object as ordered (path, values) pairs; each list must be non-empty.
 std::vector<std::pair<std::string, Json>> vary_lists(const Json& vary, const std::string& where) {
@@ -23,6 +32,7 @@ std::vector<std::pair<std::string, Json>> vary_lists(const Json& vary, const std
   for (const auto& [path, values] : vary.items()) {
     if (!values.is_array() || values.empty())
       throw ConfigError(where + "." + path, "got " + values.dump() + ", expected a non-empty list of values");
+    refuse_plugins_path(path, where + "." + path);
     out.emplace_back(path, values);
   }
   return out;
@@ -67,7 +77,7 @@ bool is_unknown_parameter(const ConfigError& e) {
 }  // namespace
 
 Study expand_study(const Json& spec, const Registry& registry, const std::vector<std::string>& overrides,
-                   const std::string& study_path, const RunSettings& settings) {
+                   const std::string& study_path, const RunSettings& settings, bool build_runs) {
   if (!spec.is_object()) throw ConfigError("study", "got " + spec.dump() + ", expected a JSON object");
   for (const auto& [key, value] : spec.items())
     if (key != "kind" && key != "title" && key != "base" && key != "vary" && key != "cases")
@@ -89,6 +99,8 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
   for (const auto& assignment : overrides) {  // its syntax first: "--set time.h" lacks a value
     Json scratch = Json::object();
     apply_override(scratch, assignment);
+    const std::string path = assignment.substr(0, assignment.find('='));
+    refuse_plugins_path(path, "--set " + path);
   }
   // A --set on a path the study varies (or a case sets) would be silently replaced: refused.
   for (const auto& assignment : overrides) {
@@ -128,6 +140,7 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
     if (!set.is_object()) throw ConfigError(where + ".set", "got " + set.dump() + ", expected an object of path: value");
     std::vector<std::string> set_paths;
     for (const auto& [path, value] : set.items()) {
+      refuse_plugins_path(path, where + ".set." + path);
       assign_path(config, path, value, where + ".set." + path);
       leaf_paths(path, value, set_paths);
     }
@@ -215,6 +228,27 @@ Study expand_study(const Json& spec, const Registry& registry, const std::vector
       const std::string what = e.what();
       const std::string message = e.field().empty() ? what : what.substr(e.field().size() + 2);
       throw ConfigError(e.field(), fmt::format("{} (run {}: {})", message, run.id, describe_assignments(run.assignments)));
+    }
+  }
+  // Each run's objects built once and dropped: what only its model or data can say (a grid
+  // that does not fit, a u0 of the wrong shape, the model's own checks) is said now.
+  std::set<std::string> built;
+  for (const auto& run : study.runs) {
+    if (!build_runs) break;
+    Json key = run.config;
+    if (key.contains("time")) key["time"].erase("h");
+    if (!built.insert(key.dump()).second) continue;
+    throw_if_stop_requested("checking the study's runs before any runs");
+    try {
+      plan_run(run.config, registry, settings, false);
+    } catch (const Interrupted&) {
+      throw;
+    } catch (const Error& e) {  // a ConfigError keeps its field; a data file's error has none
+      const auto* config_error = dynamic_cast<const ConfigError*>(&e);
+      const std::string field = config_error ? config_error->field() : std::string();
+      const std::string what = e.what();
+      const std::string message = field.empty() ? what : what.substr(field.size() + 2);
+      throw ConfigError(field, fmt::format("{} (run {}: {})", message, run.id, describe_assignments(run.assignments)));
     }
   }
   return study;

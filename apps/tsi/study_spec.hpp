@@ -40,8 +40,11 @@ inline constexpr long max_study_runs = 100000;
 /// Validates and expands a study; every run is resolved before any runs, so a bad path or
 /// value is reported (naming the run and the path) before work starts. `overrides` are
 /// --set assignments applied to the base. Files the runs name (model.u0 as a .npy file) are
-/// relative to the directory of `study_path` (empty: the working directory).
+/// relative to the directory of `study_path` (empty: the working directory). With
+/// `build_runs`, every run's objects are also built once (plan_run: the model's own checks,
+/// its data, the memory check) and dropped, so that no run fails on its input after others
+/// have computed; runs that differ only in time.h are built once.
 Study expand_study(const Json& spec, const Registry& registry, const std::vector<std::string>& overrides,
-                   const std::string& study_path = {}, const RunSettings& settings = {});
+                   const std::string& study_path = {}, const RunSettings& settings = {}, bool build_runs = true);
 
 }  // namespace tsi::app

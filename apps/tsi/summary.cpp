@@ -95,6 +95,7 @@ std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
   s += fmt::format("  written: {0}/result.json, {0}/invariants.csv", out_dir);
   if (outcome.u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, u_final_file);
   if (outcome.reference_u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, reference_u_final_file);
+  if (!outcome.u_times.empty() && outcome.u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, u_times_file);
   s += "\n";
   return s;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "tsi/algebra.hpp"
+#include "tsi/stop_request.hpp"
 
 namespace tsi {
 namespace {
@@ -21,6 +22,7 @@ int AndersonSolver::iterate(Vector& x, FixedPointMap g, Real& increment) {
   if (residual_diffs_.size() != static_cast<size_t>(depth_)) residual_diffs_.resize(depth_), map_diffs_.resize(depth_);
   int stored = 0, next_column = 0;
   for (int k = 1; k <= options().max_iter; ++k) {
+    throw_if_stop_requested("iterating an implicit stage (a step left unfinished)");  // a sweep can take seconds
     g(x, gx_);
     algebra::axpby(1.0, gx_, -1.0, x, residual_);
     increment = this->increment(gx_, x);

@@ -12,6 +12,8 @@
 
 #include "tsi/error.hpp"
 #include "tsi/fft.hpp"
+#include "tsi/matrix_model.hpp"
+#include "tsi/memory.hpp"
 #include "tsi/npy.hpp"
 #include "reformulations/two_scale.hpp"
 
@@ -45,20 +47,6 @@ Json without_name(const Json& section) {
 bool supports(const SchemeEntry& scheme, const std::string& reformulation) {
   const auto& r = scheme.traits.reformulations;
   return std::find(r.begin(), r.end(), reformulation) != r.end();
-}
-
-// The memory the machine can give a run now (MemAvailable), or its physical memory.
-double available_bytes() {
-  std::ifstream meminfo("/proc/meminfo");
-  for (std::string key; meminfo >> key;) {
-    double kb = 0.0;
-    meminfo >> kb;
-    if (key == "MemAvailable:") return kb * 1024.0;
-    meminfo.ignore(64, '\n');
-  }
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page)
-                               : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace
@@ -114,20 +102,33 @@ Footprint two_scale_footprint(const Model& model, const Params& reformulation, c
 
 namespace {
 
-// Refused before anything of the state's size is allocated when the run cannot fit.
-void check_footprint(const Footprint& f, double limit) {
-  if (f.state_bytes <= 0.0) return;
+// Refused before anything of the state's size is allocated when the run cannot fit, with what
+// the caller keeps besides (`kept` bytes, named by `kept_field`).
+void check_footprint(const Footprint& f, double limit, double kept_states, double physical_dim,
+                     const std::string& kept_field) {
+  const double kept = 16.0 * kept_states * physical_dim;
   const bool machine = !(limit > 0.0);
-  const double available = machine ? available_bytes() : limit;
-  if (!(f.bytes() > available)) return;
-  throw ConfigError(
-      "reformulation.n_tau",
-      fmt::format("got {:.0f}: with the model's {:.0f} unknowns a run needs about {:.3g} GB: {:.3g} vectors of "
-                  "{:.0f} x {:.0f} complex values ({:.3g} GB each; tau modes 0 .. n_tau/2 for a real model): the state, {:.3g} of scheme \"{}\", {:.3g} of "
-                  "the two-scale problem and {:.3g} of its prepared data; {} has {:.3g} GB available",
-                  f.n_tau, f.dim, f.bytes() / 1e9, f.vectors, f.dim, f.state_bytes / (16.0 * f.dim), f.state_bytes / 1e9, f.scheme_vectors,
-                  f.scheme, f.problem_vectors, f.preparation_vectors,
-                  machine ? std::string("this machine") : std::string("the memory limit"), available / 1e9));
+  const double available = machine ? allocatable_bytes() : limit;
+  const std::string who = machine ? std::string("this process") : std::string("the memory limit");
+  if (f.state_bytes > 0.0 && f.bytes() > available)
+    throw ConfigError(
+        "reformulation.n_tau",
+        fmt::format("got {:.0f}: with the model's {:.0f} unknowns a run needs about {:.3g} GB: {:.3g} vectors of "
+                    "{:.0f} x {:.0f} complex values ({:.3g} GB each; tau modes 0 .. n_tau/2 for a real model): the "
+                    "state, {:.3g} of scheme \"{}\", {:.3g} of the two-scale problem and {:.3g} of its prepared data; "
+                    "{} has {:.3g} GB available",
+                    f.n_tau, f.dim, f.bytes() / 1e9, f.vectors, f.dim, f.state_bytes / (16.0 * f.dim),
+                    f.state_bytes / 1e9, f.scheme_vectors, f.scheme, f.problem_vectors, f.preparation_vectors, who,
+                    available / 1e9));
+  if (kept > 0.0 && f.bytes() + kept > available)
+    throw ConfigError(kept_field, fmt::format("got {:.0f} times: their states ({:.0f} x {:.0f} complex values) take "
+                                              "{:.3g} GB while the run goes{}; {} has {:.3g} GB available: ask for "
+                                              "fewer times, or save states to files as the run goes "
+                                              "(output.state_every)",
+                                              kept_states, kept_states, physical_dim, kept / 1e9,
+                                              f.bytes() > 0.0 ? fmt::format(", besides the run's {:.3g} GB", f.bytes() / 1e9)
+                                                              : std::string(),
+                                              who, available / 1e9));
 }
 
 // Whether a model's "u0" is the common parameter (an array, or the name of a .npy file); a
@@ -219,8 +220,42 @@ std::string entry_name(std::uint64_t flat, const std::vector<std::uint64_t>& sha
   return fmt::format("entry {} (index {} of shape {})", flat, npy_shape_text(index), npy_shape_text(shape));
 }
 
-// model.u0 from a .npy file: as many values as the model's dimension, in any shape; finite;
-// real for a real model (a complex file whose imaginary parts are all zero is taken).
+// A shape without its axes of length 1: a file of shape (8, 6, 1) holds an (8, 6) grid.
+std::vector<std::uint64_t> without_unit_axes(std::vector<std::uint64_t> shape) {
+  shape.erase(std::remove(shape.begin(), shape.end(), std::uint64_t{1}), shape.end());
+  return shape;
+}
+
+// A model whose physical state has several axes (a 2-D or 3-D grid) reads model.u0's file in
+// that shape, in C order; a file of another shape holds the same count of values in another
+// order (a transposed grid, a flat array that does not say its order) and is refused, naming
+// both shapes. A model of one axis takes any shape (its values in C order).
+void check_u0_shape(const std::vector<std::uint64_t>& expected, const NpyHeader& header, const std::string& file) {
+  const std::vector<std::uint64_t> want = without_unit_axes(expected), got = without_unit_axes(header.shape);
+  if (want.size() < 2 || got == want) return;
+  std::string hint;
+  std::vector<std::uint64_t> sorted_want = want, sorted_got = got;
+  std::sort(sorted_want.begin(), sorted_want.end());
+  std::sort(sorted_got.begin(), sorted_got.end());
+  if (got.size() == 1)
+    hint = fmt::format("a flat array does not say in which order its values go: save a.reshape{} if they go in C "
+                       "order (the last axis fastest)",
+                       npy_shape_text(want));
+  else if (std::equal(got.begin(), got.end(), want.rbegin(), want.rend()))
+    hint = "its axes are reversed (a transposed array?): save np.ascontiguousarray(a.T)";
+  else if (sorted_got == sorted_want)
+    hint = "its axes are in another order: save np.ascontiguousarray(a.transpose(...)) with them in the model's order";
+  else
+    hint = "the same count of values in another shape would be read in the wrong order";
+  throw ConfigError("model.u0",
+                    fmt::format("{}: an array of shape {}, expected shape {} (the model's state in physical variables, "
+                                "in C order: the last axis fastest); {}",
+                                file, npy_shape_text(header.shape), npy_shape_text(expected), hint));
+}
+
+// model.u0 from a .npy file: as many values as the model's dimension, in the model's shape
+// where it has several axes (check_u0_shape), else in any shape; finite; real for a real model
+// (a complex file whose imaginary parts are all zero is taken).
 Vector initial_value_from_file(const Model& model, const std::string& file) {
   const auto refuse = [&](const std::string& what) {
     return ConfigError("model.u0", fmt::format("{}: {}", file, what));
@@ -232,10 +267,21 @@ Vector initial_value_from_file(const Model& model, const std::string& file) {
     throw ConfigError("model.u0", e.what());
   }
   const std::string kind = model.is_complex() ? "complex" : "real";
+  std::vector<std::uint64_t> expected;
+  std::uint64_t product = 1;
+  for (const Index n : model.physical_shape()) {
+    expected.push_back(static_cast<std::uint64_t>(n));
+    product *= static_cast<std::uint64_t>(n);
+  }
+  // A declared shape that does not hold the model's dimension (a split run's share) says nothing.
+  const bool one_axis =
+      without_unit_axes(expected).size() < 2 || product != static_cast<std::uint64_t>(model.physical_dim());
   if (header.count != static_cast<std::uint64_t>(model.physical_dim()))
     throw refuse(fmt::format("{} values (shape {}), expected {} (the model's dimension: {} values in physical "
-                             "variables, in any shape)",
-                             header.count, npy_shape_text(header.shape), model.physical_dim(), kind));
+                             "variables, {})",
+                             header.count, npy_shape_text(header.shape), model.physical_dim(), kind,
+                             one_axis ? std::string("in any shape") : "of shape " + npy_shape_text(expected)));
+  if (!one_axis) check_u0_shape(expected, header, file);
   NpyArray array;
   try {
     array = read_npy(file);
@@ -290,6 +336,9 @@ Assembly assemble(const ResolvedSelection& resolved, const Registry& registry, c
   a.scheme_entry = &registry.scheme(resolved.scheme.name);
   a.model = a.model_entry->create(Params(resolved.model.params, options.context));
   a.u0 = initial_value(*a.model, resolved.model.params);
+  // A matrix model refuses a tau grid that aliases its frequencies (matrix_model.hpp).
+  if (const Json n_tau = resolved.reformulation.params.value("n_tau", Json()); n_tau.is_number_integer())
+    check_matrix_model_n_tau(*a.model_entry, *a.model, n_tau.get<long>());
   a.traits = scheme_traits(*a.scheme_entry, resolved.scheme.params);
   // The scheme first (its parameters only): its vector count for the problem's layout sizes the
   // footprint, checked before the reformulation allocates anything of the state's size.
@@ -298,7 +347,8 @@ Assembly assemble(const ResolvedSelection& resolved, const Registry& registry, c
   const bool binds = options.h > 0.0;
   a.footprint = two_scale_footprint(*a.model, reformulation_params, *a.scheme, a.scheme_entry->info.name, binds,
                                     options.context);
-  check_footprint(a.footprint, options.memory_bytes);
+  check_footprint(a.footprint, options.memory_bytes, options.kept_states,
+                  static_cast<double>(a.model->physical_dim()), options.kept_states_field);
   a.reformulation = a.reformulation_entry->create(a.model, reformulation_params);
   const StepperTraits& traits = a.traits;
   const std::string pair = fmt::format("model \"{}\" on the \"{}\" reformulation", a.model_entry->info.name,

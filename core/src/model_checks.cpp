@@ -413,7 +413,7 @@ std::string ModelChecks::diagnose(const SchemeEntry& scheme, Real eps, const Vec
     causes.push_back(fmt::format(
         "measured: J Hess H1 at u0 has size {:.3g}, so h = {:g} times it is {:.2g}: the nonlinear part is "
         "stiff and limits h to about 2 / {:.3g} = {:.2g} whatever eps. If a large linear part sits in H1, "
-        "hand it over as Model::linear_remainder (docs/writing-a-model.md) so that it is integrated exactly",
+        "hand it over as Model::linear_remainder (docs/explanation/model-interface.md) so that it is integrated exactly",
         stiffness, coarsest, coarsest * stiffness, stiffness, 2.0 / stiffness));
   const std::vector<long> finest = {options_.steps.back()};
   const Real plain = errors(scheme, eps, x_ref, finest).front();
@@ -537,7 +537,7 @@ void ModelChecks::envelope(const SchemeEntry& scheme, const std::vector<Real>& s
     // part, the errors there climb from the averaged regime's constant to the resolved one's
     // (FD on Klein-Gordon, eps <= 1e-2: from 0.03 h^2 to 0.1 h^2, under the 0.3 h^2 reached at
     // eps ~ 0.1), or at a step-size resonance stay at the data's defect, O(eps^2) < h^2 (the
-    // particle model; docs/high-order.md). A miss is judged once more on the maximum over
+    // particle model; docs/benchmarks/high-order.md). A miss is judged once more on the maximum over
     // [eps_min, top], the bound's own range as far as the model shows it, sampled as densely.
     std::vector<Real> wider = eps_sample({sample.front(), top}, options_.steps, true);
     wider.insert(wider.end(), sample.begin(), sample.end());

@@ -428,4 +428,25 @@ void write_npy(const std::string& path, const Vector& values, bool complex_value
                    });
 }
 
+void write_npy_rows(const std::string& path, const std::vector<Vector>& rows, Index row_size, bool complex_values,
+                    const std::vector<std::uint64_t>& shape) {
+  const auto width = static_cast<std::uint64_t>(row_size);
+  const std::uint64_t count = rows.size() * width;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // The value at flat index i: row i / width, or NaN where that row was not computed.
+  const auto value = [&](std::uint64_t i) -> Complex {
+    const Vector& row = rows[i / width];
+    return row.size() == row_size ? row(static_cast<Index>(i % width)) : Complex(nan, nan);
+  };
+  const std::size_t item = complex_values ? 16 : 8;
+  write_atomically(path, npy_header(complex_values ? "<c16" : "<f8", checked_shape(path, count, shape)), count, item,
+                   [&](std::uint64_t first, std::size_t n, unsigned char* out) {
+                     for (std::size_t k = 0; k < n; ++k) {
+                       const Complex x = value(first + k);
+                       to_little(to_double(x.real()), out + item * k);
+                       if (complex_values) to_little(to_double(x.imag()), out + item * k + 8);
+                     }
+                   });
+}
+
 }  // namespace tsi

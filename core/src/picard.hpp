@@ -1,6 +1,7 @@
 #pragma once
 #include "tsi/algebra.hpp"
 #include "tsi/fixed_point.hpp"
+#include "tsi/stop_request.hpp"
 
 namespace tsi {
 
@@ -14,6 +15,7 @@ class PicardSolver final : public FixedPointSolver {
   int iterate(Vector& x, FixedPointMap g, Real& increment) override {
     next_.resize(x.size());
     for (int k = 1; k <= options().max_iter; ++k) {
+      throw_if_stop_requested("iterating an implicit stage (a step left unfinished)");  // a sweep can take seconds
       g(x, next_);
       increment = this->increment(next_, x);
       algebra::swap(x, next_);

@@ -10,6 +10,7 @@
 #include "fftw_precision.hpp"
 #include "tsi/error.hpp"
 #include "tsi/fft.hpp"
+#include "tsi/memory.hpp"
 #include "tsi/phase.hpp"
 
 namespace tsi {
@@ -411,6 +412,13 @@ std::vector<int> spectral_grid_shape(const Params& params) {
     points *= n;
     shape.push_back(n);
   }
+  // The model holds u0 and a work grid of these points before the run sizes its state (whose
+  // footprint is checked next): refused here, before either is allocated.
+  check_allocation("model.n_x",
+                   32.0 * static_cast<double>(points),
+                   fmt::format("a grid of {} = {} points (the model's u0 and a work grid of complex values, before the "
+                               "run's state of n_tau such grids)",
+                               fmt::join(shape, " x "), points));
   return shape;
 }
 

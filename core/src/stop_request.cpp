@@ -9,6 +9,7 @@ namespace {
 
 std::atomic<int> requested{0};
 static_assert(std::atomic<int>::is_always_lock_free);
+std::atomic<int> pauses{0};  // live StopPollsPaused guards
 
 }  // namespace
 
@@ -21,8 +22,12 @@ int stop_signal() { return requested.load(); }
 
 void clear_stop_request() { requested.store(0); }
 
-void throw_if_stop_requested(const std::string& where) {
-  if (const int signal = requested.load(); signal != 0) throw Interrupted(signal, where);
+void throw_if_stop_requested(const char* where) {
+  if (const int signal = requested.load(); signal != 0 && pauses.load() == 0) throw Interrupted(signal, where);
 }
+
+StopPollsPaused::StopPollsPaused() { ++pauses; }
+
+StopPollsPaused::~StopPollsPaused() { --pauses; }
 
 }  // namespace tsi

@@ -9,6 +9,7 @@
 #include <pybind11/stl.h>
 
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <csignal>
 #include <exception>
@@ -108,6 +109,57 @@ Result interruptible(Work&& work, bool& was_interrupted, const std::function<voi
 
 // ---- Models written in Python -------------------------------------------------------------
 
+std::string type_name(const py::handle& value) {
+  return py::str(py::type::handle_of(value).attr("__name__")).cast<std::string>();
+}
+
+// What a Python function returned, as a message names it: "a NoneType", "an array of shape
+// (3, 64) and dtype float64".
+std::string described(const py::handle& value) {
+  if (py::isinstance<py::array>(value)) {
+    const auto a = py::reinterpret_borrow<py::array>(value);
+    std::string shape;
+    for (py::ssize_t k = 0; k < a.ndim(); ++k) shape += (k ? ", " : "") + std::to_string(a.shape(k));
+    if (a.ndim() == 1) shape += ",";
+    return fmt::format("an array of shape ({}) and dtype {}", shape, py::str(a.dtype()).cast<std::string>());
+  }
+  return "a " + type_name(value);
+}
+
+// What `who` returned as Values (a complex matrix or vector, a double), or a tsi::Error naming
+// what it returned and what was expected instead of pybind11's "Unable to cast".
+template <class Values>
+Values returned(const py::object& value, const std::string& who, const std::string& expected) {
+  try {
+    return value.cast<Values>();
+  } catch (const py::cast_error&) {
+    throw tsi::Error(fmt::format("{} returned {}, expected {}", who, described(value), expected));
+  }
+}
+
+// Refuses complex values with an imaginary part that a function of a real model or field
+// returned: the real states would drop it silently. A real array (the usual return) is not scanned.
+template <class Values>
+void check_real(const py::handle& value, const Values& values, const std::string& who, const char* remedy) {
+  if (py::isinstance<py::array>(value)) {
+    const char kind = py::reinterpret_borrow<py::array>(value).dtype().kind();
+    if (kind == 'f' || kind == 'i' || kind == 'u' || kind == 'b') return;
+  }
+  if ((values.imag().array() == 0.0).all()) return;
+  throw tsi::Error(fmt::format("{} returned complex values (imaginary parts up to {:.3g}) where the states are real, "
+                               "which would drop them: {}",
+                               who, values.imag().cwiseAbs().maxCoeff(), remedy));
+}
+
+// Python's truth values: bool and numpy.bool_ (not 1, "yes" or None).
+bool is_bool(py::handle value) {
+  return PyBool_Check(value.ptr()) || type_name(value) == "bool_";
+}
+bool is_integer(py::handle value) { return !is_bool(value) && PyIndex_Check(value.ptr()) != 0; }
+bool is_real(py::handle value) {
+  return !is_bool(value) && !PyComplex_Check(value.ptr()) && PyNumber_Check(value.ptr()) != 0;
+}
+
 // Calls into a Python model, with the GIL, turning a Python exception into a tsi::Error that
 // names the model and the method (the run then fails with that message, as a C++ model's would).
 template <class F>
@@ -127,16 +179,26 @@ class PythonModel final : public tsi::Model, public tsi::HamiltonianStructure, p
  public:
   PythonModel(double eps, py::object instance, std::string name)
       : Model(eps), name_(std::move(name)), self_(instance.release().ptr()) {
-    py::handle self(self_);
-    dim_ = self.attr("dim").cast<tsi::Index>();
-    if (dim_ <= 0) throw tsi::ConfigError("model.name", fmt::format("python model \"{}\": dim = {}, expected a positive integer", name_, dim_));
-    complex_ = py::hasattr(self, "is_complex") && self.attr("is_complex").cast<bool>();
-    has_filtered_ = py::hasattr(self, "filtered_field");
-    has_derivative_ = py::hasattr(self, "nonlinear_field_derivative");
-    // `hamiltonian = False`: the general class, with apply_A instead of apply_M, apply_J and H1.
-    hamiltonian_ = !py::hasattr(self, "hamiltonian") || self.attr("hamiltonian").cast<bool>();
-    has_apply_A_ = py::hasattr(self, "apply_A");
-    max_frequency_ = py::hasattr(self, "max_linear_frequency") ? self.attr("max_linear_frequency").cast<double>() : 1.0;
+    try {
+      py::handle self(self_);
+      dim_ = attribute<tsi::Index>("dim", "a positive integer", is_integer);
+      if (dim_ <= 0) throw tsi::ConfigError("model.name", fmt::format("python model \"{}\": dim = {}, expected a positive integer", name_, dim_));
+      complex_ = py::hasattr(self, "is_complex") && attribute<bool>("is_complex", "True or False", is_bool);
+      has_filtered_ = py::hasattr(self, "filtered_field");
+      has_derivative_ = py::hasattr(self, "nonlinear_field_derivative");
+      // `hamiltonian = False`: the general class, with apply_A instead of apply_M, apply_J and H1.
+      hamiltonian_ = !py::hasattr(self, "hamiltonian") || attribute<bool>("hamiltonian", "True or False", is_bool);
+      has_apply_A_ = py::hasattr(self, "apply_A");
+      if (py::hasattr(self, "max_linear_frequency")) {
+        max_frequency_ = attribute<double>("max_linear_frequency", "a finite positive number", is_real);
+        if (!(std::isfinite(max_frequency_) && max_frequency_ > 0))  // the fast period divides by it
+          throw tsi::ConfigError("model.name", fmt::format("python model \"{}\": max_linear_frequency = {}, expected a "
+                                                           "finite positive number", name_, max_frequency_));
+      }
+    } catch (...) {
+      py::handle(self_).dec_ref();  // no destructor runs for a constructor that throws
+      throw;
+    }
   }
   ~PythonModel() override {
     if (Py_IsInitialized()) {
@@ -222,7 +284,9 @@ class PythonModel final : public tsi::Model, public tsi::HamiltonianStructure, p
     out = call_python(name_, "apply_J", [&] { return vector(self().attr("apply_J")(one(u)), "apply_J"); });
   }
   double H1(const tsi::Vector& u) const override {
-    return call_python(name_, "H1", [&] { return self().attr("H1")(one(u)).cast<double>(); });
+    return call_python(name_, "H1", [&] {
+      return returned<double>(self().attr("H1")(one(u)), who("H1"), "a real number");
+    });
   }
   tsi::Vector initial_value() const override {
     return call_python(name_, "initial_value",
@@ -231,6 +295,22 @@ class PythonModel final : public tsi::Model, public tsi::HamiltonianStructure, p
 
  private:
   py::handle self() const { return py::handle(self_); }
+  std::string who(const char* method) const { return fmt::format("python model \"{}\": {}", name_, method); }
+
+  // An attribute of the instance as T; one of the wrong type is a ConfigError that names it.
+  template <class T>
+  T attribute(const char* attribute, const char* expected, bool (*accepted)(py::handle)) const {
+    const py::object value = self().attr(attribute);
+    if (accepted(value)) {
+      try {
+        return value.cast<T>();
+      } catch (const py::cast_error&) {  // an integer beyond the type: refused below
+      }
+    }
+    throw tsi::ConfigError("model.name", fmt::format("python model \"{}\": {} = {} ({}), expected {}", name_, attribute,
+                                                     py::repr(value).cast<std::string>(),
+                                                     type_name(value), expected));
+  }
 
   // States as numpy arrays, one column per state: float64 for a real model (the real parts),
   // complex128 otherwise.
@@ -243,8 +323,13 @@ class PythonModel final : public tsi::Model, public tsi::HamiltonianStructure, p
     return py::cast(tsi::RealVector(u.real()));
   }
 
+  static constexpr const char* real_remedy = "return real values, or declare is_complex = True in the class";
+
   void store(tsi::MatrixRef out, const py::object& value, const char* method) const {
-    const tsi::Matrix m = value.cast<tsi::Matrix>();
+    const tsi::Matrix m = returned<tsi::Matrix>(value, who(method),
+                                                fmt::format("an array of shape ({}, {}) of numbers: one column per "
+                                                            "state", out.rows(), out.cols()));
+    if (!complex_) check_real(value, m, who(method), real_remedy);
     if (m.rows() != out.rows() || m.cols() != out.cols())
       throw tsi::Error(fmt::format("python model \"{}\": {} returned shape ({}, {}), expected ({}, {}): one column "
                                    "per state",
@@ -252,7 +337,8 @@ class PythonModel final : public tsi::Model, public tsi::HamiltonianStructure, p
     out = m;
   }
   tsi::Vector vector(const py::object& value, const char* method) const {
-    const tsi::Vector v = value.cast<tsi::Vector>();
+    const tsi::Vector v = returned<tsi::Vector>(value, who(method), fmt::format("an array of dim = {} numbers", dim_));
+    if (!complex_) check_real(value, v, who(method), real_remedy);
     if (v.size() != dim_)
       throw tsi::Error(fmt::format("python model \"{}\": {} returned {} entries, expected dim = {}", name_, method,
                                    v.size(), dim_));
@@ -276,10 +362,14 @@ tsi::ParamSpec param_from_default(const std::string& name, const Json& value) {
   throw tsi::ConfigError("params." + name, "got " + value.dump() + ", expected a number, integer, boolean, string or list default");
 }
 
+constexpr int max_n_tau = 1 << 20;  // as reformulation.n_tau
+constexpr int max_threads = 1024;   // as the runner's --threads
+
 // Registers (or re-registers: a notebook cell run twice) a Python class as model `name`.
 void register_python_model(const std::string& name, py::object cls, const std::string& params_text,
                            const std::vector<std::string>& aliases, int n_tau, int degree, const std::string& summary) {
-  if (n_tau < 2 || n_tau % 2 != 0) throw tsi::ConfigError("n_tau", fmt::format("got {}, expected a positive even integer", n_tau));
+  if (n_tau < 2 || n_tau > max_n_tau || n_tau % 2 != 0)
+    throw tsi::ConfigError("n_tau", fmt::format("got {}, expected an even integer from 2 to {}", n_tau, max_n_tau));
   if (degree < 0) throw tsi::ConfigError("nonlinearity_degree", fmt::format("got {}, expected 0 (not polynomial) or the degree", degree));
   const Json params = parse(params_text, "params");
   tsi::ModelEntry entry;
@@ -328,7 +418,13 @@ class PythonField final : public tsi::Field {
     py::gil_scoped_acquire gil;
     try {
       py::object u = complex_ ? py::cast(tsi::Matrix(states)) : py::cast(Eigen::MatrixXd(states.real()));
-      const tsi::Matrix m = py::handle(function_)(py::cast(t), u).cast<tsi::Matrix>();
+      const py::object value = py::handle(function_)(py::cast(t), u);
+      const std::string who = fmt::format("python field \"{}\": f(t, u)", name_);
+      const tsi::Matrix m = returned<tsi::Matrix>(value, who, fmt::format("an array of u's shape ({}, {}) of numbers",
+                                                                          out.rows(), out.cols()));
+      if (!complex_)
+        check_real(value, m, who, "return real values, or register the field with is_complex=True (tsi.solve: a "
+                                  "complex u0 or A)");
       if (m.rows() != out.rows() || m.cols() != out.cols())
         throw tsi::Error(fmt::format("python field \"{}\": f(t, u) returned shape ({}, {}), expected ({}, {}): one "
                                      "column per state",
@@ -336,9 +432,6 @@ class PythonField final : public tsi::Field {
       out = m;
     } catch (py::error_already_set& e) {
       throw tsi::Error(fmt::format("python field \"{}\": f(t, u): {}", name_, e.what()));
-    } catch (const py::cast_error& e) {
-      throw tsi::Error(fmt::format("python field \"{}\": f(t, u) returned a value of the wrong type: {}", name_,
-                                   e.what()));
     }
   }
 
@@ -362,7 +455,14 @@ void register_python_field(const std::string& name, py::object function, long di
   entry.time_dependent = time_dependent;
   entry.is_complex = is_complex;
   if (!u0.is_none()) {
-    entry.initial_value = u0.cast<tsi::Vector>();
+    try {
+      entry.initial_value = u0.cast<tsi::Vector>();
+    } catch (const py::cast_error&) {
+      throw tsi::ConfigError("u0", fmt::format("got {}, expected a 1-d array of numbers", described(u0)));
+    }
+    if (!is_complex && !(entry.initial_value.imag().array() == 0.0).all())
+      throw tsi::ConfigError("u0", "has complex entries, but the field is real (is_complex=False): their imaginary "
+                                   "parts would be dropped");
     if (dim != 0 && entry.initial_value.size() != dim)
       throw tsi::ConfigError("u0", fmt::format("has {} entries, expected dim = {}", entry.initial_value.size(), dim));
     if (!entry.initial_value.allFinite()) throw tsi::ConfigError("u0", "has an entry that is not finite");
@@ -463,7 +563,9 @@ py::dict outcome_dict(const tsi::app::RunOutcome& outcome) {
 }
 
 py::dict run(const std::string& config_text, const std::string& out_dir, int threads, bool show_progress) {
-  if (threads < 0) throw tsi::ConfigError("threads", "got " + std::to_string(threads) + ", expected at least 1 (or None: all cores)");
+  if (threads < 0 || threads > max_threads)
+    throw tsi::ConfigError("threads", fmt::format("got {}, expected an integer from 1 to {} (or None: all cores)", threads,
+                                                  max_threads));
   tsi::Registry& registry = session_registry();
   const Json raw = parse(config_text, "config");
   if (raw.is_object() && raw.contains("plugins")) tsi::app::load_config_plugins(loader(), raw["plugins"], "./config");
@@ -492,6 +594,9 @@ py::dict run(const std::string& config_text, const std::string& out_dir, int thr
 
 py::dict study(const std::string& spec_text, int jobs, const std::vector<std::string>& overrides,
                const std::string& out_dir, bool show_progress) {
+  if (jobs < 0 || jobs > max_threads)
+    throw tsi::ConfigError("jobs", fmt::format("got {}, expected an integer from 1 to {} (0 or None: all cores)", jobs,
+                                               max_threads));
   tsi::Registry& registry = session_registry();
   const Json spec = parse(spec_text, "study");
   if (spec.is_object() && spec.contains("base") && spec["base"].is_object() && spec["base"].contains("plugins"))
@@ -557,6 +662,10 @@ void translate(std::exception_ptr p) {
 PYBIND11_MODULE(_tsi, m) {
   m.doc() = "tsi's native module: use the package tsi";
   m.attr("version") = tsi::version_string;
+  // The limits the package checks arguments against before it calls in.
+  m.attr("max_matrix_model_dim") = tsi::max_matrix_model_dim;
+  m.attr("max_output_times") = tsi::app::max_output_times;
+  m.attr("max_steps") = tsi::app::default_max_steps;
 
   error_type = PyErr_NewExceptionWithDoc("tsi.Error", "An error tsi reports.", PyExc_RuntimeError, nullptr);
   config_error_type =

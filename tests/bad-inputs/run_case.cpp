@@ -11,6 +11,14 @@
 //   config: PATH              pass PATH instead of the body file
 //   out: PATH | none          --out (default {dir}/out); none: no --out
 //   touch: NAME / mkdir: NAME create an empty file / a directory in {dir} before the run
+//   npy: NAME DTYPE SHAPE [fortran] VALUES
+//                             write NAME in {dir} as a .npy file (format 1.0, as np.save): DTYPE
+//                             NumPy's descr ('<f8', '>f8', '<f4', '<c16', '<c8', '<i8', '<i4'),
+//                             SHAPE the tuple as Python writes it ("(2, 4)", "(8,)", "()"),
+//                             `fortran` for fortran_order True, then the values in order (nan and
+//                             inf taken; N*X is X N times; a complex dtype's imaginary parts are
+//                             0). Their count is not checked against SHAPE: a short list makes a
+//                             truncated file (repeatable)
 //   exit: N                   the expected exit code (default 2)
 //   field: FIELD              stderr must contain "tsi: error: FIELD:" (or "FIELD." and a path inside)
 //   expect: TEXT              stderr must contain TEXT (repeatable)
@@ -18,9 +26,14 @@
 // Any other `//` line is a description. In values, {dir} is the case's directory and
 // {config} the body file.
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
+#include <sstream>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "runner/run_command.hpp"
@@ -36,9 +49,72 @@ std::string substitute(std::string text, const std::string& dir, const std::stri
   return text;
 }
 
+// The bytes of a .npy file from a case's `npy:` value "NAME DTYPE SHAPE [fortran] VALUES"
+// (the case's directory prefixed to NAME by the caller): the name and the file's bytes.
+std::pair<std::string, std::string> npy_file(const std::string& spec) {
+  std::istringstream in(spec);
+  std::string name, descr;
+  in >> name >> descr;
+  std::string rest;
+  std::getline(in, rest);
+  const std::size_t open = rest.find('('), close = rest.find(')');
+  if (name.empty() || descr.size() < 3 || open == std::string::npos || close == std::string::npos || close < open)
+    throw std::runtime_error("npy: expected NAME DTYPE SHAPE [fortran] VALUES, got \"" + spec + "\"");
+  const std::string shape = rest.substr(open, close - open + 1);
+  std::istringstream values(rest.substr(close + 1));
+  bool fortran = false;
+  const char order = descr[0], kind = descr[1];
+  const int size = std::stoi(descr.substr(2)), components = kind == 'c' ? 2 : 1, part = size / components;
+  std::string data;
+  // One component of `part` bytes, little-endian in memory (the catalogue runs on x86-64 and
+  // AArch64 Linux), reversed for a big-endian dtype.
+  const auto put = [&](double x) {
+    char bytes[8];
+    if (kind == 'i' && part == 8) {
+      const auto v = static_cast<std::int64_t>(x);
+      std::memcpy(bytes, &v, 8);
+    } else if (kind == 'i' && part == 4) {
+      const auto v = static_cast<std::int32_t>(x);
+      std::memcpy(bytes, &v, 4);
+    } else if ((kind == 'f' || kind == 'c') && part == 8) {
+      std::memcpy(bytes, &x, 8);
+    } else if ((kind == 'f' || kind == 'c') && part == 4) {
+      const auto v = static_cast<float>(x);
+      std::memcpy(bytes, &v, 4);
+    } else {
+      throw std::runtime_error("npy: unsupported dtype " + descr);
+    }
+    if (order == '>') std::reverse(bytes, bytes + part);
+    data.append(bytes, static_cast<std::size_t>(part));
+  };
+  for (std::string token; values >> token;) {
+    if (token == "fortran") {
+      fortran = true;
+      continue;
+    }
+    const std::size_t star = token.find('*');
+    const long repeat = star == std::string::npos ? 1 : std::stol(token.substr(0, star));
+    const double x = std::stod(star == std::string::npos ? token : token.substr(star + 1));
+    for (long k = 0; k < repeat; ++k) {
+      put(x);
+      if (components == 2) put(0.0);
+    }
+  }
+  std::string dict = "{'descr': '" + descr + "', 'fortran_order': " + (fortran ? "True" : "False") +
+                     ", 'shape': " + shape + ", }";
+  dict.append(63 - (10 + dict.size()) % 64, ' ');  // the data start on a multiple of 64 bytes
+  dict += '\n';
+  std::string file = "\x93NUMPY";
+  file += '\x01';
+  file += '\x00';
+  file += static_cast<char>(dict.size() & 0xff);
+  file += static_cast<char>(dict.size() >> 8);
+  return {name, file + dict + data};
+}
+
 struct Case {
   std::string command = "run", config, out, field;
-  std::vector<std::string> args, expect, touch, mkdir;
+  std::vector<std::string> args, expect, touch, mkdir, npy;
   bool has_config = false, has_out = false;
   int exit = 2;
   double timeout = 60.0;
@@ -63,6 +139,7 @@ Case parse_case(const std::string& text) {
     else if (key == "out") c.out = value, c.has_out = true;
     else if (key == "touch") c.touch.push_back(value);
     else if (key == "mkdir") c.mkdir.push_back(value);
+    else if (key == "npy") c.npy.push_back(value);
     else if (key == "exit") c.exit = std::stoi(value);
     else if (key == "field") c.field = value;
     else if (key == "expect") c.expect.push_back(value);
@@ -93,6 +170,15 @@ int main(int argc, char** argv) {
   write_text(body_file, c.body);
   for (const auto& name : c.mkdir) fs::create_directories(dir.path() / substitute(name, root, body_file));
   for (const auto& name : c.touch) write_text(dir.path() / substitute(name, root, body_file), "");
+  try {
+    for (const auto& spec : c.npy) {
+      const auto [name, bytes] = npy_file(spec);
+      write_text(dir.path() / name, bytes);
+    }
+  } catch (const std::exception& e) {
+    std::cerr << case_file << ": " << e.what() << "\n";
+    return 1;
+  }
 
   const std::string config = c.has_config ? substitute(c.config, root, body_file) : body_file;
   const std::string out = c.has_out ? substitute(c.out, root, body_file) : dir / "out";

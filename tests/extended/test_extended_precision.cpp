@@ -116,7 +116,7 @@ double linear_test_error(const Json& scheme, double eps, long n) {
 const Json collocation = {{"name", "collocation"}, {"tol", quad ? 1e-33 : 1e-19}, {"max_iter", 1000}};
 
 TEST_CASE("extended precision: eab of orders 3 to 6 on the linear test, uniform in eps, below double's floor") {
-  // Measured in double (examples/general/linear-test-extended.json, docs/high-order.md): eab
+  // Measured in double (examples/general/linear-test-extended.json, docs/benchmarks/extended-precision.md): eab
   // r = 6 stops at 1e-15 .. 6e-13 from h = 1/128 on (rounding, amplified near resonances); in long double
   // it falls to 1.3e-18 .. 6e-18 at h = 1/512, in quad to 8.1e-19 .. 6.0e-18 there.
   const std::vector<long> steps = {16, 32, 64, 128, 256, 512};
@@ -193,7 +193,7 @@ TEST_CASE("extended precision: Henon-Heiles against rk78 on the filtered problem
   // rk78's error grows with its substeps. In long double tol 1e-19 and 1e-20 differ by 5.6e-18
   // at eps = 0.1 and 7.3e-17 at eps = 0.01; eab r = 6 falls to 3.7e-17 (h = 1/512) at eps = 0.1;
   // at eps = 0.01 its rounding, amplified, stops it at 2e-16 .. 5e-16 from h = 1/512, so the
-  // fit ends at h = 1/256 there (docs/high-order.md, "Extended precision"). In quad, collocation
+  // fit ends at h = 1/256 there (docs/benchmarks/extended-precision.md, "Extended precision"). In quad, collocation
   // with 4 stages (order 8 at fixed eps) falls to 1.8e-26 at h = 1/512 against rk78 at tol 1e-33.
   struct Case {
     double eps;

@@ -224,5 +224,5 @@ TEST_CASE("collocation: one stage is SE1, three stages bound the error by C h^4 
   const tsi::OrderFit fit = tsi::fit_order(step_sizes(steps), worst, 1e-10);
   CAPTURE(fit.order);
   REQUIRE(fit.measurable);
-  CHECK(fit.order > 3.7);  // measured 4.0 over 16 eps (docs/high-order.md)
+  CHECK(fit.order > 3.7);  // measured 4.0 over 16 eps (docs/benchmarks/high-order.md)
 }

@@ -411,7 +411,7 @@ TEST_CASE("klein-gordon: every two-scale scheme is uniformly second order at T =
   // 1.2e-4, 5.0e-5 for h = 1/16 .. 1/128, order 1.74 over 1/64 .. 1/512); its eps are 1, 1/256,
   // 1e-4 and 1e-6 (orders 1.92 .. 2.01).
   // eps = 1e-2 is left out: h = 1/16 and 1/32 are there within 1% of 2 and 1 half fast periods
-  // pi eps, the step-size resonance Henon-Heiles shows at the same eps (docs/writing-a-model.md);
+  // pi eps, the step-size resonance Henon-Heiles shows at the same eps (docs/explanation/model-interface.md);
   // SE1's error at h = 1/32 is 10 times the limit's there.
   for (int grid : {n_x, 64}) {
     for (const auto* scheme : tsi::test::second_order_schemes()) {

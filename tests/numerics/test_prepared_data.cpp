@@ -3,7 +3,7 @@
 // stay bounded as eps -> 0 while derivative k + 1 grows like 1/eps. The derivatives are
 // measured on the two-scale flow itself, dU/dt = L U + N(U):
 //   d1 = L U + N(U),  d2 = L d1 + DN(U) d1,  d3 = L d2 + DN(U) d2 + D2N(U)[d1, d1].
-// Data of any order by the recursion along an averaged trajectory (docs/high-order.md,
+// Data of any order by the recursion along an averaged trajectory (docs/explanation/high-order.md,
 // "Prepared data of any order") against the central difference quotients.
 #include <doctest/doctest.h>
 

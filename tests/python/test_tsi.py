@@ -429,8 +429,9 @@ class PythonModelTests(unittest.TestCase):
         self.assertEqual(caught.exception.field, "model.scale")
 
     def test_a_cpp_models_name_is_refused(self):
-        with self.assertRaises(tsi.PluginError):
+        with self.assertRaises(tsi.ConfigError) as caught:
             tsi.register_model("henon-heiles", HenonHeiles)
+        self.assertEqual(caught.exception.field, "name")
 
 
 QUICKSTART_A = [[0, 0, 1, 0], [0, 0, 0, 0], [-1, 0, 0, 0], [0, 0, 0, 0]]
@@ -516,8 +517,9 @@ class SolveTests(unittest.TestCase):
         self.assertLess(r.error_estimate / error, 2.0)
 
     def test_solve_refuses_an_empty_span(self):
-        with self.assertRaises(ValueError):
+        with self.assertRaises(tsi.ConfigError) as caught:
             tsi.solve(self.A, lambda t, u: 0 * u, 1e-3, [0, 0, 0, 0], (1.0, 1.0))
+        self.assertEqual(caught.exception.field, "t_span")
 
 
 class MatrixModelTests(unittest.TestCase):
@@ -592,8 +594,9 @@ class MatrixModelTests(unittest.TestCase):
         self.assertIn("deliberately broken", r.message)
 
     def test_a_cpp_fields_name_is_refused(self):
-        with self.assertRaises(tsi.PluginError):
+        with self.assertRaises(tsi.ConfigError) as caught:
             tsi.register_field("quickstart", quickstart_f)
+        self.assertEqual(caught.exception.field, "name")
 
     def test_the_wrong_size_is_refused(self):
         with self.assertRaises(tsi.ConfigError) as caught:
@@ -683,6 +686,270 @@ class PlotTests(unittest.TestCase):
         s = tsi.study({"kind": "conservation", "base": HH, "vary": {"time.h": [0.5]}}, jobs=1)
         with self.assertRaises(ValueError):
             tsi.plot.convergence(s)
+
+
+class BadArgumentTests(unittest.TestCase):
+    """Every bad argument of run, study, solve, register_model and register_field raises
+    tsi.ConfigError naming it (and saying what was expected) before anything is computed."""
+
+    SPEC = {"base": HH, "vary": {"time.h": [0.5, 0.25]}}
+
+    def refused(self, field, call, words):
+        with self.assertRaises(tsi.ConfigError) as caught:
+            call()
+        self.assertEqual((caught.exception.field, str(caught.exception).startswith(field + ": "),
+                          words in str(caught.exception)), (field, True, True), str(caught.exception))
+
+    def test_run(self):
+        nan_u0 = np.array([0.1, 0.2, np.nan, 0.3])
+        looped = with_(HH)
+        looped["model"]["self"] = looped
+        for field, config, words in (
+                ("model.eps", with_(HH, model={"eps": float("nan")}), "got nan, expected a finite number"),
+                ("time.h", with_(HH, time={"h": float("inf")}), "got inf, expected a finite number"),
+                ("model.u0[2]", with_(HH, model={"u0": nan_u0}), "got nan, expected a finite number"),
+                ("model.eps", with_(HH, model={"eps": {0.1}}), "(set), expected a JSON value"),
+                ("model", {"model": {("name",): "hh"}}, "expected string keys"),
+                ("model.self", looped, "contains itself")):
+            with self.subTest(field=field, words=words):
+                self.refused(field, lambda: tsi.run(config), words)
+        for field, kwargs, words in (
+                ("threads", {"threads": "2"}, "got '2' (str), expected an integer from 1 to 1024"),
+                ("threads", {"threads": 1.5}, "got 1.5 (float), expected an integer"),
+                ("threads", {"threads": True}, "got True (bool), expected an integer"),
+                ("threads", {"threads": 0}, "got 0 (int), expected an integer from 1 to 1024"),
+                ("threads", {"threads": 10 ** 12}, "expected an integer from 1 to 1024"),
+                ("out", {"out": 5}, "got 5 (int), expected a directory"),
+                ("progress", {"progress": "no"}, "got 'no' (str), expected True or False")):
+            with self.subTest(**kwargs):
+                self.refused(field, lambda: tsi.run(HH, **kwargs), words)
+
+    def test_study(self):
+        nan_h = {"base": HH, "vary": {"time.h": [0.5, float("nan")]}}
+        for field, spec, kwargs, words in (
+                ("jobs", self.SPEC, {"jobs": "2"}, "got '2' (str), expected an integer from 1 to 1024"),
+                ("jobs", self.SPEC, {"jobs": -1}, "got -1 (int), expected an integer from 1 to 1024"),
+                ("jobs", self.SPEC, {"jobs": 2.5}, "got 2.5 (float)"),
+                ("jobs", self.SPEC, {"jobs": 2 ** 40}, "expected an integer from 1 to 1024"),
+                ("overrides", self.SPEC, {"overrides": "model.eps=0.1"}, "expected a dict"),
+                ("overrides[0]", self.SPEC, {"overrides": [0.1]}, "expected a \"path=value\" string"),
+                ("--set model.eps", self.SPEC, {"overrides": {"model.eps": float("nan")}}, "got nan"),
+                ("vary.time.h[1]", nan_h, {}, "got nan, expected a finite number"),
+                ("out", self.SPEC, {"out": object()}, "expected a directory"),
+                ("progress", self.SPEC, {"progress": 1}, "got 1 (int), expected True or False")):
+            with self.subTest(field=field, kwargs=kwargs):
+                self.refused(field, lambda: tsi.study(spec, **kwargs), words)
+
+    def test_solve(self):
+        calls = []
+
+        def f(t, u):
+            calls.append(t)
+            return 0 * u
+
+        A, u0 = QUICKSTART_A, QUICKSTART_U0
+        good = {"A": A, "f": f, "eps": 1e-3, "u0": u0, "t_span": (0.0, 1.0)}
+        for field, change, words in (
+                ("A", {"A": "A"}, "got 'A' (str), expected a square matrix"),
+                ("A", {"A": [[0, 1], [1]]}, "expected a square matrix"),
+                ("A", {"A": [[0, 1, 0], [1, 0, 0]]}, "got an array of shape (2, 3)"),
+                ("A[1][0]", {"A": [[0, 1], [np.nan, 0]], "u0": [1, 0]}, "got nan, expected a finite number"),
+                ("A", {"A": [[object()]]}, "of numbers"),
+                ("A", {"A": np.zeros((1025, 1025))}, "1 x 1 to 1024 x 1024"),
+                ("u0", {"u0": [0.1, 0.2, 0.3]}, "expected a 1-d array of 4 numbers (A is 4 x 4)"),
+                ("u0", {"u0": np.ones((2, 2))}, "got an array of shape (2, 2)"),
+                ("u0", {"u0": None}, "got None (NoneType)"),
+                ("u0[3]", {"u0": [0, 0, 0, np.inf]}, "got inf, expected a finite number"),
+                ("f", {"f": 3}, "got 3 (int), expected a function f(t, u)"),
+                ("f", {"f": lambda u: u}, "cannot be called as f(t, u)"),
+                ("eps", {"eps": "1e-3"}, "got '1e-3' (str), expected a number in (0, 1]"),
+                ("eps", {"eps": np.array([1e-3])}, "got an array of shape (1,)"),
+                ("eps", {"eps": float("nan")}, "got nan (float)"),
+                ("eps", {"eps": 2.0}, "got 2.0, expected a number in (0, 1]"),
+                ("t_span", {"t_span": 1.0}, "got 1.0 (float), expected (t0, t1)"),
+                ("t_span", {"t_span": (0, 1, 2)}, "expected (t0, t1): two finite numbers"),
+                ("t_span[1]", {"t_span": (0, float("inf"))}, "got inf (float), expected a finite real number"),
+                ("t_span[0]", {"t_span": ("0", 1)}, "got '0' (str)"),
+                ("t_span", {"t_span": (1.0, 0.0)}, "got (1.0, 0.0), expected t0 < t1"),
+                ("t_span", {"t_span": (-1e308, 1e308)}, "beyond a double"),
+                ("h", {"h": 0}, "got 0.0, expected a step in (0, 1.0]"),
+                ("h", {"h": -0.1}, "got -0.1, expected a step in (0, 1.0]"),
+                ("h", {"h": 5}, "got 5.0, expected a step in (0, 1.0]"),
+                ("h", {"h": "0.1"}, "got '0.1' (str)"),
+                ("h", {"h": 1e-12}, "got 1e-12 for t_span (0.0, 1.0): u at every step would be 1e+12 states of 4 "
+                                    "float64, 3.2e+13 bytes"),
+                ("h", {"h": 1e-12, "times": [0.5]}, "1e+12 steps, more than a run takes (1e+09"),
+                ("times[0]", {"times": [2.0]}, "got 2.0, outside t_span (0.0, 1.0)"),
+                ("times[1]", {"times": [0.5, -1.0]}, "got -1.0, outside t_span (0.0, 1.0)"),
+                ("times[0]", {"times": [np.nan]}, "got nan, expected a finite number"),
+                ("times", {"times": 0.5}, "got 0.5 (float), expected a 1-d list of 1 to 100000 times"),
+                ("times", {"times": [[0.5]]}, "expected a 1-d list"),
+                ("times", {"times": []}, "expected a 1-d list of 1 to 100000 times"),
+                ("times", {"times": "0.5"}, "got '0.5' (str)"),
+                ("scheme", {"scheme": 4}, "got 4 (int), expected a scheme's name"),
+                ("scheme", {"scheme": [("name", "eab")]}, "expected a scheme's name"),
+                ("scheme.order", {"scheme": {"name": "eab", "order": np.nan}}, "got nan"),
+                ("scheme.name", {"scheme": "no-such-scheme"}, "unknown scheme"),
+                ("n_tau", {"n_tau": "32"}, "got '32' (str), expected an even integer from 2 to 1048576"),
+                ("n_tau", {"n_tau": 31.5}, "got 31.5 (float)"),
+                ("n_tau", {"n_tau": 33}, "got 33, expected an even integer"),
+                ("time_dependent", {"time_dependent": "no"}, "got 'no' (str), expected True or False"),
+                ("error_estimate", {"error_estimate": None}, "got None (NoneType), expected True or False"),
+                ("threads", {"threads": "2"}, "expected an integer from 1 to 1024"),
+                ("out", {"out": 5}, "expected a directory")):
+            with self.subTest(field=field, change=change):
+                self.refused(field, lambda: tsi.solve(**dict(good, **change)), words)
+                self.assertLessEqual(len(calls), 1)  # at most f's one check: no run started
+                calls.clear()
+
+    def test_solve_checks_f_once_before_the_run(self):
+        A, u0 = QUICKSTART_A, QUICKSTART_U0
+        for words, f in (("returned None (NoneType), expected an array of u's shape (4, 1)", lambda t, u: None),
+                         ("returned 'x' (str)", lambda t, u: "x"),
+                         ("returned shape (3, 1), expected (4, 1)", lambda t, u: u[:3]),
+                         ("returned shape (), expected (4, 1)", lambda t, u: 1.0),
+                         ("returned nan, expected finite values", lambda t, u: u * np.nan),
+                         ("returned complex values for a real problem", lambda t, u: 1j * u),
+                         ("raised ZeroDivisionError: division by zero", lambda t, u: 1 / 0)):
+            with self.subTest(words=words):
+                self.refused("f", lambda: tsi.solve(A, f, 1e-3, u0, (0.0, 1.0)),
+                             "f(t, u) at t = t0 = 0.0, u = u0 (a 4 x 1 column) " + words)
+        # Complex values later in the run fail it (tsi.Error), with the field and the reason named.
+        with self.assertRaises(tsi.Error) as caught:
+            tsi.solve(A, lambda t, u: 0 * u + 1j * (t > 0.5), 1e-3, u0, (0.0, 1.0))
+        self.assertIn("f(t, u) returned complex values (imaginary parts up to 1) where the states are real",
+                      str(caught.exception))
+        # A zero imaginary part is taken: the state is the real f's.
+        real = tsi.solve(A, quickstart_f, 1e-3, u0, (0.0, 1.0), h=0.25)[1]
+        zero = tsi.solve(A, lambda t, u: quickstart_f(t, u) + 0j, 1e-3, u0, (0.0, 1.0), h=0.25)[1]
+        np.testing.assert_array_equal(zero, real)
+
+    def test_register_model(self):
+        class NoSelfField(HenonHeiles):
+            def nonlinear_field(self):
+                return None
+
+        class Incomplete:
+            dim = 4
+
+            def __init__(self, eps):
+                pass
+
+        class WordDim(HenonHeiles):
+            dim = "four"
+
+        class NeedsScale(HenonHeiles):
+            def __init__(self, eps, scale):
+                super().__init__(eps)
+
+        for field, args, kwargs, words in (
+                ("name", (5, HenonHeiles), {}, "got 5 (int), expected the model's name"),
+                ("name", ("", HenonHeiles), {}, "got '', expected the model's name"),
+                ("name", (" py-x", HenonHeiles), {}, "without spaces around it"),
+                ("name", ("henon-heiles", HenonHeiles), {}, "\"henon-heiles\" is already registered by"),
+                ("name", ("hh", HenonHeiles), {}, "as an alias of \"henon-heiles\""),
+                ("cls", ("py-x", 5), {}, "got 5 (int), expected a class, built as cls(eps, **params)"),
+                ("cls", ("py-x", HenonHeiles(0.1)), {}, "expected a class"),
+                ("cls", ("py-x", NeedsScale), {}, "cannot be built as cls(eps, **params) with params []"),
+                ("cls", ("py-x", HenonHeiles), {"params": {"scale": 1.0}}, "with params ['scale']"),
+                ("cls.nonlinear_field", ("py-x", NoSelfField), {}, "cannot be called as nonlinear_field(U)"),
+                ("cls.linear_flow", ("py-x", Incomplete), {}, "Incomplete has no method linear_flow(taus, U)"),
+                ("cls.dim", ("py-x", WordDim), {}, "got 'four' (str), expected a positive integer"),
+                ("params", ("py-x", HenonHeiles), {"params": [1]}, "got [1] (list), expected a dict"),
+                ("params", ("py-x", HenonHeiles), {"params": {"a.b": 1}}, "Python identifiers"),
+                ("params.eps", ("py-x", HenonHeiles), {"params": {"eps": 0.1}}, "common to every model"),
+                ("params.scale", ("py-x", NeedsScale), {"params": {"scale": np.nan}}, "got nan"),
+                ("params.scale", ("py-x", NeedsScale), {"params": {"scale": None}}, "got null, expected a number"),
+                ("aliases", ("py-x", HenonHeiles), {"aliases": "hhx"}, "got 'hhx' (str), expected a list of names"),
+                ("aliases[0]", ("py-x", HenonHeiles), {"aliases": ["hh"]}, "\"hh\" is already registered by"),
+                ("aliases[0]", ("py-x", HenonHeiles), {"aliases": ["py-x"]}, "the name itself"),
+                ("aliases[1]", ("py-x", HenonHeiles), {"aliases": ["a", "a"]}, "twice"),
+                ("aliases[0]", ("py-x", HenonHeiles), {"aliases": [None]}, "got None (NoneType)"),
+                ("n_tau", ("py-x", HenonHeiles), {"n_tau": "64"}, "got '64' (str), expected an even integer"),
+                ("n_tau", ("py-x", HenonHeiles), {"n_tau": 63}, "got 63, expected an even integer from 2 to 1048576"),
+                ("n_tau", ("py-x", HenonHeiles), {"n_tau": 64.5}, "got 64.5 (float)"),
+                ("n_tau", ("py-x", HenonHeiles), {"n_tau": 2 ** 40}, "expected an even integer from 2 to 1048576"),
+                ("nonlinearity_degree", ("py-x", HenonHeiles), {"nonlinearity_degree": -1}, "got -1 (int)"),
+                ("nonlinearity_degree", ("py-x", HenonHeiles), {"nonlinearity_degree": 2.5}, "got 2.5 (float)"),
+                ("summary", ("py-x", HenonHeiles), {"summary": 5}, "got 5 (int), expected a string")):
+            with self.subTest(field=field, words=words):
+                self.refused(field, lambda: tsi.register_model(*args, **kwargs), words)
+        self.assertNotIn("py-x", [m["name"] for m in tsi.list("models")])  # nothing half-registered
+
+    def test_a_refused_registration_keeps_the_earlier_one(self):
+        tsi.register_model("py-kept", HenonHeiles, nonlinearity_degree=2)
+        self.refused("n_tau", lambda: tsi.register_model("py-kept", HenonHeiles, n_tau=3), "got 3")
+        self.assertEqual(tsi.run(with_(HH, model={"name": "py-kept"})).status, "completed")
+
+    def test_a_python_models_bad_attributes_and_returns_are_named(self):
+        class FloatDim(HenonHeiles):
+            def __init__(self, eps):
+                super().__init__(eps)
+                self.dim = 4.0
+
+        class Imaginary(HenonHeiles):
+            def filtered_field(self, taus, u):
+                return super().filtered_field(taus, u) * (1 + 1e-3j)
+
+        class ImaginaryStart(HenonHeiles):
+            def initial_value(self):
+                return 1j * super().initial_value()
+
+        class Words(HenonHeiles):
+            def filtered_field(self, taus, u):
+                return "x"
+
+        class ZeroImaginary(HenonHeiles):
+            def filtered_field(self, taus, u):
+                return super().filtered_field(taus, u) + 0j
+
+        for name, cls in (("py-float-dim", FloatDim), ("py-imaginary", Imaginary), ("py-words", Words),
+                          ("py-imaginary-start", ImaginaryStart), ("py-zero-imaginary", ZeroImaginary)):
+            tsi.register_model(name, cls, nonlinearity_degree=2)
+        self.refused("model.name", lambda: tsi.run(with_(HH, model={"name": "py-float-dim"})),
+                     "python model \"py-float-dim\": dim = 4.0 (float), expected a positive integer")
+        r = tsi.run(with_(HH, model={"name": "py-imaginary"}))
+        self.assertEqual(r.status, "failed")
+        self.assertIn("python model \"py-imaginary\": filtered_field returned complex values (imaginary parts up to",
+                      r.message)
+        r = tsi.run(with_(HH, model={"name": "py-words"}))
+        self.assertEqual(r.status, "failed")
+        self.assertIn("python model \"py-words\": filtered_field returned a str, expected an array of shape (4, 64)",
+                      r.message)
+        with self.assertRaises(tsi.Error) as caught:
+            tsi.run(with_(HH, model={"name": "py-imaginary-start"}))
+        self.assertIn("python model \"py-imaginary-start\": initial_value returned complex values",
+                      str(caught.exception))
+        zero, real = tsi.run(with_(HH, model={"name": "py-zero-imaginary"})), tsi.run(HH)
+        self.assertLess(np.linalg.norm(zero.u_final - real.u_final), 1e-12)
+
+    def test_register_field(self):
+        for field, args, kwargs, words in (
+                ("name", (5, quickstart_f), {}, "got 5 (int), expected the field's name"),
+                ("name", ("quickstart", quickstart_f), {}, "\"quickstart\" is already registered by core"),
+                ("f", ("py-f-x", 5), {}, "got 5 (int), expected a function f(t, u)"),
+                ("f", ("py-f-x", lambda u: u), {}, "cannot be called as f(t, u)"),
+                ("dim", ("py-f-x", quickstart_f), {"dim": "4"}, "got '4' (str), expected 0 (any) or a size"),
+                ("dim", ("py-f-x", quickstart_f), {"dim": -1}, "got -1 (int)"),
+                ("dim", ("py-f-x", quickstart_f), {"dim": 2 ** 40}, "a size from 1 to 1024"),
+                ("time_dependent", ("py-f-x", quickstart_f), {"time_dependent": "yes"}, "expected True or False"),
+                ("is_complex", ("py-f-x", quickstart_f), {"is_complex": 0}, "got 0 (int), expected True or False"),
+                ("u0", ("py-f-x", quickstart_f), {"u0": "abc"}, "got 'abc' (str), expected a 1-d array of numbers"),
+                ("u0", ("py-f-x", quickstart_f), {"u0": [[1, 2], [3, 4]]}, "got an array of shape (2, 2)"),
+                ("u0[1]", ("py-f-x", quickstart_f), {"u0": [0, np.nan]}, "got nan, expected a finite number"),
+                ("u0", ("py-f-x", quickstart_f), {"dim": 4, "u0": [1, 2]}, "expected a 1-d array of dim = 4 numbers"),
+                ("u0[1]", ("py-f-x", quickstart_f), {"u0": [1, 2j]}, "got 2j, expected a real number: the real field"),
+                ("summary", ("py-f-x", quickstart_f), {"summary": None}, "got None (NoneType), expected a string")):
+            with self.subTest(field=field, words=words):
+                self.refused(field, lambda: tsi.register_field(*args, **kwargs), words)
+        self.assertNotIn("py-f-x", [f["name"] for f in tsi.list("fields")])
+
+    def test_a_python_fields_complex_values_fail_a_real_run(self):
+        tsi.register_field("py-imaginary-f", lambda t, u: quickstart_f(t, u) * (1 + 1e-3j), dim=4)
+        r = tsi.run({"model": {"name": "matrix", "A": QUICKSTART_A, "f": "py-imaginary-f", "eps": 1e-4,
+                               "u0": QUICKSTART_U0}, "scheme": {"name": "se1"}, "time": {"h": 0.5, "t_end": 1.0}})
+        self.assertEqual(r.status, "failed")
+        self.assertIn("python field \"py-imaginary-f\": f(t, u) returned complex values", r.message)
 
 
 if __name__ == "__main__":

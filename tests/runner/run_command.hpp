@@ -65,6 +65,9 @@ struct CommandEnv {
   /// The child's RLIMIT_FSIZE in bytes (-1: unchanged), with SIGXFSZ ignored: a write past
   /// it fails with EFBIG, as on a full disk.
   long long file_size_limit = -1;
+  /// The child's RLIMIT_AS in bytes (-1: unchanged): an allocation past it fails, as under
+  /// `ulimit -v` or a container's memory limit.
+  long long address_space_limit = -1;
 };
 
 /// What mpirun needs here: root allowed (CI containers), one machine without network (shared
@@ -138,7 +141,7 @@ inline CommandResult run_command(const std::string& program, const std::vector<s
 
   pid_t pid = 0;
   int spawn_error = 0;
-  if (env.file_size_limit < 0) {
+  if (env.file_size_limit < 0 && env.address_space_limit < 0) {
     spawn_error = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), envp.data());
   } else {  // posix_spawn cannot set a resource limit: fork, set it in the child, exec
     pid = ::fork();
@@ -148,10 +151,16 @@ inline CommandResult run_command(const std::string& program, const std::vector<s
       if (in < 0 || ::dup2(in, STDIN_FILENO) < 0 || ::dup2(out_pipe[1], STDOUT_FILENO) < 0 ||
           ::dup2(err_pipe[1], STDERR_FILENO) < 0 || (!cwd.empty() && ::chdir(cwd.c_str()) != 0))
         ::_exit(127);
-      const rlimit limit{static_cast<rlim_t>(env.file_size_limit), static_cast<rlim_t>(env.file_size_limit)};
-      struct sigaction ignore {};
-      ignore.sa_handler = SIG_IGN;
-      if (::setrlimit(RLIMIT_FSIZE, &limit) != 0 || ::sigaction(SIGXFSZ, &ignore, nullptr) != 0) ::_exit(127);
+      if (env.file_size_limit >= 0) {
+        const rlimit limit{static_cast<rlim_t>(env.file_size_limit), static_cast<rlim_t>(env.file_size_limit)};
+        struct sigaction ignore {};
+        ignore.sa_handler = SIG_IGN;
+        if (::setrlimit(RLIMIT_FSIZE, &limit) != 0 || ::sigaction(SIGXFSZ, &ignore, nullptr) != 0) ::_exit(127);
+      }
+      if (env.address_space_limit >= 0) {
+        const rlimit limit{static_cast<rlim_t>(env.address_space_limit), static_cast<rlim_t>(env.address_space_limit)};
+        if (::setrlimit(RLIMIT_AS, &limit) != 0) ::_exit(127);
+      }
       ::execve(program.c_str(), argv.data(), envp.data());
       ::_exit(127);
     }

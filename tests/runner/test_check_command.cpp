@@ -139,7 +139,7 @@ TEST_CASE("check: --set reaches the schemes and the two-scale problem of every r
 
 TEST_CASE("check: every shipped scheme passes on every shipped model, or is undecidable, for eps users type") {
   // The eps lists a user is likely to type, 1e-2 .. 1e-4 (1e-6 takes minutes per model: the
-  // rk78 references cost 1/eps; measured by hand, docs/high-order.md, as are NLS and the
+  // rk78 references cost 1/eps; measured by hand, docs/benchmarks/high-order.md, as are NLS and the
   // particle model with 1e-2, 1e-3, 1e-4: 78 s and 154 s). Every check passes or says why it
   // cannot decide.
   const std::vector<std::vector<std::string>> lists = {

@@ -153,7 +153,7 @@ TEST_CASE("full disk: a run whose invariants.csv cannot grow stops with exit cod
   check_no_temporaries(dir.path() / "out");
 }
 
-TEST_CASE("full disk: when result.json itself cannot be written, no partial file is left") {
+TEST_CASE("full disk: when result.json itself cannot be written, no partial file is left, only a short record") {
   t::TempDir dir;
   t::CommandEnv env;
   env.file_size_limit = 1500;  // invariants.csv of 4 steps fits, result.json (about 3 kB) does not
@@ -163,7 +163,11 @@ TEST_CASE("full disk: when result.json itself cannot be written, no partial file
   CHECK(r.signal == 0);
   CHECK(r.exit_code == 3);
   CHECK(t::contains(r.err, "tsi: error: cannot write " + (dir / "out") + "/result.json: File too large"));
-  CHECK_FALSE(t::fs::exists(dir.path() / "out" / "result.json"));
+  // In its place, a short record of the failure (it fits where the whole one did not).
+  const t::Json result = t::read_json(dir.path() / "out" / "result.json");
+  CHECK(result.at("status") == "failed");
+  CHECK(t::contains(result.at("message").get<std::string>(), "result.json: File too large"));
+  CHECK(t::contains(result.at("message").get<std::string>(), "the run's own status: completed"));
   CHECK(check_valid_csv(dir.path() / "out" / "invariants.csv") == 5);
   check_no_temporaries(dir.path() / "out");
 }
@@ -358,3 +362,26 @@ TEST_CASE("memory: SE1, SE2, FD and ME peak at most 8 states of resident memory 
   }
 }
 #endif
+
+TEST_CASE("io limits: a final result.json that cannot be written leaves no checkpoint saying \"running\"") {
+  // Checkpoints at every clock tick write a result.json of about 16 KB; the final one, with
+  // the dense output's 4,000 values inline, is about 160 KB: past a 100 KB file size limit.
+  t::TempDir dir;
+  t::Json config = long_hh_config(2000);
+  t::Json times = t::Json::array();
+  for (int k = 0; k < 1000; ++k) times.push_back(20.0 * k / 1000.0);
+  config["output"] = {{"every", 100000}, {"checkpoint_seconds", 1e-9}, {"times", times}};
+  t::CommandEnv env;
+  env.file_size_limit = 100 * 1024;
+  const t::CommandResult r = t::run_tsi({"run", t::write_config(dir, config), "--out", dir / "out"}, env);
+  INFO(r.describe());
+  CHECK(r.signal == 0);
+  CHECK(r.exit_code == 3);
+  CHECK(t::contains(r.err, "result.json"));
+  // The short record of the failure fits where the whole one did not.
+  const t::Json result = t::read_json(dir.path() / "out" / "result.json");
+  CHECK(result.at("status") == "failed");
+  CHECK(t::contains(result.at("message").get<std::string>(), "the run's own status: completed"));
+  CHECK(result.at("steps") == 2000);
+  check_no_temporaries(dir.path());
+}

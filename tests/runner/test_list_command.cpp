@@ -145,6 +145,70 @@ TEST_CASE("list --json: one kind at a time") {
   }
 }
 
+// `tsi list config` documents the run config (the docs' reference is generated from it): its
+// sections must be the ones a config may have, and the runner's own keys the ones a run
+// resolves, with the defaults a run records.
+TEST_CASE("list config: the run config's sections and the defaults a run records") {
+  const Json listed = list_json({"config"});
+  INFO(listed.dump(2));
+  REQUIRE(listed.size() == 1);
+  const Json& sections = listed.at("config");
+  std::vector<std::string> names;
+  for (const auto& s : sections) names.push_back(s.at("name"));
+  CHECK(names == std::vector<std::string>{"model", "reformulation", "scheme", "time", "reference", "output", "monitor",
+                                          "plugins"});
+  CHECK(entry_named(sections, "model").at("chosen_from") == "models");
+  CHECK(entry_named(sections, "scheme").at("chosen_from") == "schemes");
+
+  // an unknown section is refused with the list of valid ones: the same as listed
+  TempDir dir;
+  Json bad = small_config();
+  bad["bogus"] = Json::object();
+  const CommandResult refused = run_tsi({"run", write_config(dir, bad, "bad.json"), "--dry-run"});
+  INFO(refused.describe());
+  CHECK(refused.exit_code == 2);
+  std::string valid;
+  for (const auto& n : names) valid += (valid.empty() ? "" : ", ") + n;
+  CHECK(contains(refused.err, "valid sections are: " + valid));
+
+  // a run (with the default reference) records every listed key of the runner's sections,
+  // and the listed default where the config gives none
+  Json config = small_config();
+  config["reference"] = Json::object();
+  const CommandResult run = run_tsi({"run", write_config(dir, config), "--out", dir / "out", "--quiet"});
+  INFO(run.describe());
+  REQUIRE(run.exit_code == 0);
+  const Json resolved = read_json(dir.path() / "out" / "result.json").at("config");
+  int checked = 0;
+  for (const char* name : {"time", "reference", "output", "monitor"}) {
+    const Json section = entry_named(sections, name);
+    REQUIRE(section.contains("params"));
+    for (const auto& p : section.at("params")) {
+      const std::string key = p.at("name");
+      INFO(name << "." << key);
+      if (config.contains(name) && config[name].contains(key)) continue;
+      if (p.at("default").is_null()) continue;  // decided by the run (reference.h: t_end)
+      REQUIRE(resolved.at(name).contains(key));
+      CHECK(resolved.at(name).at(key) == p.at("default"));
+      ++checked;
+    }
+    for (const auto& [key, value] : resolved.at(name).items()) {
+      INFO("resolved " << name << "." << key);
+      CHECK(param_named(section, key).is_object());
+    }
+  }
+  CHECK(checked >= 10);
+}
+
+TEST_CASE("list config: the text form") {
+  const CommandResult r = run_tsi({"list", "config"});
+  INFO(r.describe());
+  REQUIRE(r.exit_code == 0);
+  for (const char* part : {"config:", "  time  ", "t_end", "checkpoint_seconds", "max_err_H", "(tsi list schemes)"})
+    CHECK_MESSAGE(contains(r.out, part), "missing: " << part);
+  CHECK_FALSE(contains(r.out, "henon-heiles"));
+}
+
 TEST_CASE("list: the text form names every entry and its provider") {
   const CommandResult r = run_tsi({"list"});
   INFO(r.describe());
@@ -181,7 +245,7 @@ TEST_CASE("list: an unknown kind is bad input") {
 }
 
 // `tsi --plugin FILE list` marks exactly what FILE registered: the fixture "general" adds the
-// model fixture-quickstart and the fields fixture-quickstart-f and fixture-linear. The fixture
+// model fixture-quickstart and the fields fixture-quickstart-f, fixture-linear and fixture-zero-f. The fixture
 // "good", loaded beside it through TSI_PLUGIN_PATH, and the shipped plugins stay unmarked.
 TEST_CASE("list --plugin FILE: exactly the entries FILE registered are marked") {
   // (paths built with fs::path: g++ 12 -O3 warns falsely on fixture_plugin's string sums here)
@@ -191,7 +255,7 @@ TEST_CASE("list --plugin FILE: exactly the entries FILE registered are marked") 
   CommandEnv env;
   env.set["TSI_PLUGIN_PATH"] = good;
   const std::set<std::string> expected = {"models/fixture-quickstart", "fields/fixture-quickstart-f",
-                                          "fields/fixture-linear"};
+                                          "fields/fixture-linear", "fields/fixture-zero-f"};
 
   SUBCASE("json: from_plugin_option on FILE's entries alone, named by a relative path") {
     // the loader records the file's canonical path; the marks must follow it

@@ -3,13 +3,17 @@
 // C++ model tests/fixtures/fixture_general.cpp; a non-periodic A is refused with the deviation
 // it measured; a time-dependent f (HOODESolver.jl's linear test, t carried as one more
 // variable) converges at the schemes' orders to the exact solution, computed here
-// independently (the exponential of an augmented matrix in long double).
+// independently (the exponential of an augmented matrix in long double); an n_tau that aliases
+// A's frequencies is refused, the next one accurate; an interrupt during the set-up of a
+// 1024 x 1024 A ends the run within a second.
 #include <doctest/doctest.h>
 
 #include <fmt/format.h>
 
 #include <Eigen/Dense>
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <string>
 #include <vector>
 #include <unsupported/Eigen/MatrixFunctions>
@@ -223,6 +227,83 @@ TEST_CASE("matrix model: against the linear test's exact solution eab of orders 
                                << envelope[0] * std::pow(4.0 * coarse[i], 2.0));
     CHECK(envelope[i] <= envelope[0] * std::pow(4.0 * coarse[i], 2.0));
   }
+}
+
+TEST_CASE("matrix model: an n_tau that aliases A's frequencies is refused, the next even one is accurate") {
+  // HOODESolver.jl's linear test with A = K times the quickstart's A (frequencies 0 and +-K):
+  // f_tau has tau harmonics up to 2K, which n_tau points resolve when n_tau/2 > 2K. Measured
+  // before the refusal existed (eab 4, h = 1/64, eps = 0.01): 1.1e-2 at n_tau = 16 and 1.6e-9 at
+  // 18 for K = 4, 1.5e-2 at 32 and 1.5e-9 at 34 for K = 8; 1.4e-9 for K = 1 at any n_tau.
+  t::TempDir dir;
+  auto run = [&](long K, const Json& n_tau, const std::string& name) {
+    Json A = quickstart_A;
+    A[0][2] = K;
+    A[2][0] = -K;
+    Json cfg = config({{"name", "matrix"}, {"eps", 0.01}, {"A", A}, {"f", "linear"}}, {{"name", "eab"}, {"order", 4}},
+                      1.0 / 64, 1.0);
+    cfg["reformulation"].erase("n_tau");
+    if (!n_tau.is_null()) cfg["reformulation"]["n_tau"] = n_tau;
+    cfg["reference"] = {{"scheme", "exact"}};
+    return t::run_tsi({"run", t::write_config(dir, cfg, name + ".json"), "--out", dir / name});
+  };
+  auto error = [&](const t::CommandResult& r, const std::string& name) {
+    INFO(r.describe());
+    REQUIRE(r.exit_code == 0);
+    return t::read_json(t::fs::path(dir / name) / "result.json")["error"]["relative"].get<double>();
+  };
+  const double floor = error(run(1, 18, "k1"), "k1");
+  for (const long K : {4L, 8L}) {
+    const t::CommandResult aliased = run(K, 4 * K, fmt::format("aliased-{}", K));
+    INFO(aliased.describe());
+    CHECK(aliased.exit_code == 2);
+    CHECK(t::contains(aliased.err, fmt::format("tsi: error: reformulation.n_tau: got {}, but model.A has "
+                                               "frequencies up to {}",
+                                               4 * K, K)));
+    CHECK(t::contains(aliased.err, fmt::format("expected n_tau > 4 x {} = {}: {} or more", K, 4 * K, 4 * K + 2)));
+    const std::string name = fmt::format("resolved-{}", K);
+    const double resolved = error(run(K, 4 * K + 2, name), name);
+    MESSAGE("K = " << K << ": error " << resolved << " at n_tau = " << 4 * K + 2 << ", " << floor << " for K = 1");
+    CHECK(resolved < 2 * floor);
+  }
+  // Without n_tau the model's default (32) is held to the same: K = 8 needs 34.
+  const t::CommandResult by_default = run(8, Json(), "default");
+  INFO(by_default.describe());
+  CHECK(by_default.exit_code == 2);
+  CHECK(t::contains(by_default.err, "tsi: error: reformulation.n_tau: got 32, but model.A has frequencies up to 8"));
+}
+
+TEST_CASE("matrix model: an interrupt during the set-up of a 1024 x 1024 A ends the run within a second") {
+  // Frequencies 0 .. 15 (the most a 1024 x 1024 A takes): its set-up is about 50 products of
+  // 1024 x 1024 matrices (6 s on 2 busy cores; before they were 33 matrix exponentials and
+  // an eigenvalue solve, 620 s on one core, deaf to Ctrl-C). The signal comes at 1 s.
+  const int n = 1024;
+  Json A = Json::array();
+  for (int i = 0; i < n; ++i) {
+    Json row = Json::array();
+    for (int j = 0; j < n; ++j) {
+      const int k = (i / 2) % 16;
+      row.push_back(j == (i ^ 1) ? (i % 2 == 0 ? k : -k) : 0);
+    }
+    A.push_back(std::move(row));
+  }
+  t::TempDir dir;
+  Json cfg = config({{"name", "matrix"}, {"eps", 0.1}, {"A", A}, {"f", "fixture-zero-f"},
+                     {"u0", Json(std::vector<double>(n, 1.0))}},
+                    {{"name", "se1"}}, 0.5, 1.0);
+  cfg["reformulation"]["n_tau"] = 64;
+  t::CommandEnv env;
+  env.send_signal = SIGINT;
+  env.signal_after_seconds = 1.0;
+  const auto start = std::chrono::steady_clock::now();
+  const t::CommandResult r = t::run_tsi(
+      {"--plugin", t::fixture_plugin("general"), "run", t::write_config(dir, cfg), "--out", dir / "out"}, env);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  INFO(r.describe());
+  MESSAGE("exit " << r.exit_code << " after " << seconds << " s (SIGINT at 1 s)");
+  CHECK(r.signal == 0);
+  CHECK(r.exit_code == 128 + SIGINT);
+  CHECK(t::contains(r.err, "interrupted by signal 2 while setting up model.A's flow"));
+  CHECK(seconds < 3.0);
 }
 
 TEST_CASE("matrix model: an exact reference is refused for a model that declares none") {

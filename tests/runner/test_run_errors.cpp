@@ -421,3 +421,46 @@ TEST_CASE("run errors: a run that cannot fit in memory is refused before anythin
   CHECK(contains(r.err, "tsi: error: reformulation.n_tau: got 1024: with the model's 1048576 unknowns a run needs"));
   CHECK(contains(r.err, "GB available"));
 }
+
+TEST_CASE("run errors: under an address-space limit a grid or a state that does not fit is refused, not bad_alloc") {
+  // ulimit -v 2 GB: a 3-D grid of 512^3 points (the model's own grids alone 4.3 GB), and a 1-D
+  // run whose two-scale state (n_tau 1024, 65536 unknowns: 1 GB a vector) does not fit either.
+  TempDir dir;
+  CommandEnv env;
+  env.address_space_limit = 2LL << 30;
+  const CommandResult grid = run_tsi({"run", (fs::path(TSI_TEST_SOURCE_DIR) / "examples/nls-se1.json").string(), "--out",
+                                      dir / "grid", "--set", "model.dims=3", "--set", "model.n_x=512"},
+                                     env);
+  INFO(grid.describe());
+  CHECK(grid.signal == 0);
+  CHECK(grid.exit_code == 2);
+  CHECK(contains(grid.err, "tsi: error: model.n_x: a grid of 512 x 512 x 512 = 134217728 points"));
+  CHECK(contains(grid.err, "this process can allocate"));
+  CHECK_FALSE(contains(grid.err, "bad_alloc"));
+  const CommandResult state = run_tsi({"run", (fs::path(TSI_TEST_SOURCE_DIR) / "examples/nls-se1.json").string(), "--out",
+                                       dir / "state", "--set", "model.n_x=65536", "--set", "reformulation.n_tau=1024"},
+                                      env);
+  INFO(state.describe());
+  CHECK(state.exit_code == 2);
+  CHECK(contains(state.err, "tsi: error: reformulation.n_tau: got 1024"));
+  CHECK(contains(state.err, "this process has"));
+  CHECK_FALSE(contains(state.err, "bad_alloc"));
+}
+
+TEST_CASE("run errors: dense output that cannot be kept in memory is refused before the run, naming output.times") {
+  // 100,000 times of a 1024 x 1024 grid: 1.7 TB of states.
+  TempDir dir;
+  Json config = read_json(fs::path(TSI_TEST_SOURCE_DIR) / "examples/nls-se1.json");
+  config["model"]["dims"] = 2;
+  config["model"]["n_x"] = 1024;
+  Json times = Json::array();
+  for (int k = 0; k < 100000; ++k) times.push_back(config["time"]["t_end"].get<double>() * k / 100000.0);
+  config["output"]["times"] = times;
+  const CommandResult r = run_tsi({"run", write_config(dir, config), "--out", dir / "out"});
+  INFO(r.err);
+  CHECK(r.signal == 0);
+  CHECK(r.exit_code == 2);
+  CHECK(contains(r.err, "tsi: error: output.times: got 100000 times: their states (100000 x 1048576 complex values) take"));
+  CHECK(contains(r.err, "output.state_every"));
+  CHECK_FALSE(fs::exists(dir.path() / "out" / "result.json"));
+}

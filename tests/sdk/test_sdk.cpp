@@ -136,7 +136,7 @@ TEST_CASE("sdk: the installed example plugins build against an installed tsi and
         "lib/tsi/plugins/tsi_rk78.so", "include/tsi/model.hpp", "include/tsi/plugin.hpp",
         "lib/cmake/tsi/tsiConfig.cmake", "lib/cmake/tsi/tsiConfigVersion.cmake",
         "lib/cmake/tsi/tsiTargets.cmake", "lib/cmake/tsi/TsiPlugin.cmake", "include/tsi/assembly.hpp",
-        "include/tsi/algebra.hpp", "include/tsi/model_checks.hpp", "share/doc/tsi/SPEC.md", "share/doc/tsi/writing-a-model.md",
+        "include/tsi/algebra.hpp", "include/tsi/model_checks.hpp", "share/doc/tsi/SPEC.md", "share/doc/tsi/model-interface.md",
         "share/tsi/examples/plugins/fput/CMakeLists.txt", "share/tsi/examples/plugins/fput/fput.cpp",
         "share/tsi/examples/plugins/expmid/CMakeLists.txt", "share/tsi/examples/plugins/expmid/expmid.cpp",
         "share/tsi/examples/plugins/van_der_pol/CMakeLists.txt", "share/tsi/examples/plugins/van_der_pol/van_der_pol.cpp",
@@ -200,7 +200,7 @@ TEST_CASE("sdk: the installed example plugins build against an installed tsi and
   // 6. The plugin passes the conformance checks, run by the example's own ctest (tsi::tsi).
   check_example(build, "fput: all");
 
-  // 7. The scheme example (docs/writing-a-scheme.md) builds the same way, passes its checks on
+  // 7. The scheme example (docs/tutorials/scheme-plugin.md) builds the same way, passes its checks on
   //    the shipped Henon-Heiles model, and is second order there at eps = 1e-4 (away from the
   //    step-size resonances h = k pi eps, where it loses an order).
   {

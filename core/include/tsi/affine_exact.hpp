@@ -17,8 +17,11 @@ inline constexpr Index max_affine_exact_dim = 32;
 /// (or x87 long double, all Eigen's matrix exponential takes) would leave 1e-9 (1e-12) of it.
 /// The inputs are the double numbers the schemes integrate. `accuracy` is the relative
 /// difference to a second evaluation with 8 times the scaling, or the rounding of u(t) to
-/// double where that is larger. Refuses (tsi::Error) n > max_affine_exact_dim, t < 0 and sizes
-/// that do not match.
+/// double where that is larger, or quad's rounding of the phases, 2^-112 |t Z|_1 (common to both
+/// evaluations). Refuses (tsi::Error) n > max_affine_exact_dim, t < 0 and sizes that do not
+/// match, and (ConfigError on reference.scheme) a |t Z|_1 beyond 5e30, whose phases quad no
+/// longer resolves to 1e-3 (eps = 1e-300 gave NaN with an accuracy of 1e-16 before), and a
+/// solution that is not finite in quad.
 TSI_API ExactSolution::Value affine_exact_solution(const Matrix& A, Real eps, const AffineTerms& f,
                                                    const Vector& u0, Real t);
 

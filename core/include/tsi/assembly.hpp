@@ -43,6 +43,11 @@ struct TSI_API AssemblyOptions {
   /// The memory a two-scale run may take, in bytes (0: what the machine has available now);
   /// a run whose footprint exceeds it is refused, naming its sizes, before it is built.
   double memory_bytes = 0.0;
+  /// States of the model's physical size that the caller keeps while the run goes (the dense
+  /// output's values at output.times), counted in the memory check before anything of the
+  /// state's size is allocated; a refusal they cause names kept_states_field.
+  double kept_states = 0.0;
+  std::string kept_states_field;
   /// What the run may use of the process (its threads), given to every entry's create().
   Context context;
 };

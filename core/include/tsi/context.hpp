@@ -21,7 +21,7 @@ struct TSI_API Context {
   /// Threads on the tau grid: the field on contiguous ranges of tau columns and the tau
   /// transforms on contiguous ranges of rows, one range per thread (OpenMP). Only grids of at
   /// least 4096 values (dim x n_tau) are split: below that the synchronisation costs more than
-  /// it saves (measured on 2 cores: 1024 values 0.74x, 4096 values 1.4-1.8x; docs/scaling.md).
+  /// it saves (measured on 2 cores: 1024 values 0.74x, 4096 values 1.4-1.8x; docs/benchmarks/threads.md).
   /// 1, the default, for none: a study already runs one run per core.
   ThreadLimit tau_grid{1, 4096};
   /// FFTW's own threads inside each transform of at least 65536 values (tsi --fft-threads).

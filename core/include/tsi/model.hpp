@@ -65,7 +65,7 @@ class TSI_API Model {
   /// The second linear part R, by the frequencies omega_j of R: R multiplies coordinate j
   /// of u by i omega_j. It must commute with A (tsi check tests it) and, for a real model, be
   /// empty (a real state cannot turn by a complex phase). Empty (the default): no remainder.
-  /// Klein-Gordon's omega_k = <D>_eps - 1/eps = k^2 / (1 + sqrt(1 + eps k^2)): bounded in eps,
+  /// Klein-Gordon's omega_k = \<D\>_eps - 1/eps = k^2 / (1 + sqrt(1 + eps k^2)): bounded in eps,
   /// up to (n_x/2)^2/2 in k, so that in f it would limit every scheme to h <~ 2 / max omega.
   virtual const RealVector& linear_remainder() const;
   /// The largest |lambda| over the eigenvalues i*lambda of A (integers, since e^{A tau} is

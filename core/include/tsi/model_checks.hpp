@@ -38,7 +38,7 @@ struct TSI_API ModelCheckReport {
 /// increase from 1 to 1000000 (a ConfigError naming --eps or --steps).
 TSI_API void check_regime(const std::vector<double>& epsilons, const std::vector<long>& steps);
 
-/// The conformance checks of one model (docs/writing-a-model.md; `tsi check` is this over the
+/// The conformance checks of one model (docs/explanation/model-interface.md; `tsi check` is this over the
 /// models selected): its interface against model-independent expectations, the observed order
 /// of every given two-scale scheme at every eps (tsi::fit_order, the runs built by the core's
 /// assembler), with the measured cause of a miss, and the symmetry of the symmetric schemes.

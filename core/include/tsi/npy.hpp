@@ -62,6 +62,12 @@ TSI_API void write_npy(const std::string& path, std::span<const Complex> values,
 TSI_API void write_npy(const std::string& path, const Vector& values, bool complex_values,
                        const std::vector<std::uint64_t>& shape = {});
 
+/// Rows of row_size values each as one array of shape `shape` (its product rows.size() x
+/// row_size), written row by row without gathering them: a row of another size (an empty one)
+/// is written as NaN. Real parts as float64 (complex_values false), else complex128.
+TSI_API void write_npy_rows(const std::string& path, const std::vector<Vector>& rows, Index row_size,
+                            bool complex_values, const std::vector<std::uint64_t>& shape);
+
 /// A shape as Python writes a tuple: "()", "(3,)", "(2, 3)".
 TSI_API std::string npy_shape_text(const std::vector<std::uint64_t>& shape);
 

@@ -13,7 +13,7 @@
 /// one C function, tsi_plugin_entry, returning a TsiPluginInfo. The loader checks, in this
 /// order, the ABI version, the size of TsiPluginInfo, the tsi major version and the layout of
 /// every structure the plugin exchanges with tsi, before it calls register_fn.
-/// What is stable and what bumps the version: docs/plugin-abi.md.
+/// What is stable and what bumps the version: docs/reference/plugin-abi.md.
 inline constexpr std::uint32_t TSI_PLUGIN_ABI_VERSION = 21;
 
 extern "C" {

@@ -58,7 +58,7 @@ struct TSI_API VerificationRegime {
   std::vector<double> epsilons = {1.0, 1e-3};  ///< in (0, 1]
   std::vector<long> steps = {4, 8, 16, 32};    ///< numbers of steps over T = 1, increasing
   /// Model parameters of the regime besides eps (a particle model's small plasma), under what
-  /// the caller sets (`tsi check --set model.*`).
+  /// the caller sets (tsi check --set model.KEY=VALUE).
   Json params = Json::object();
 };
 

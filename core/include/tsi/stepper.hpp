@@ -25,7 +25,7 @@ struct TSI_API StepperTraits {
   /// The uniform order including step-size resonances h ~ k pi eps, when it is below `order`
   /// (-1: equal; 0: bounded, no order): SE1 and SE2 reach `order` uniformly only under a
   /// numerical non-resonance condition (the paper's, section 4); at h = k pi eps their error
-  /// falls at order 1 (docs/high-order.md). `tsi check` judges the maximum over eps,
+  /// falls at order 1 (docs/explanation/high-order.md). `tsi check` judges the maximum over eps,
   /// resonances included, by it.
   int resonant_order = -1;
   bool symmetric = false;                ///< step(h) then step(-h) returns the start
@@ -38,7 +38,7 @@ struct TSI_API StepperTraits {
   /// The prepared data needed instead on a model with a linear remainder R (ModelEntry::
   /// linear_remainder), when more (0: initial_data_order). The data's defect grows with
   /// eps |R|; a scheme that turns it by a wrong phase (FD's Crank-Nicolson fraction) needs
-  /// it smaller (Klein-Gordon: docs/high-order.md).
+  /// it smaller (Klein-Gordon: docs/explanation/high-order.md).
   int remainder_data_order = 0;
   /// The prepared data this scheme needs on a model with (true) or without a remainder.
   int data_order_for(bool linear_remainder) const {

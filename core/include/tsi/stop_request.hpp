@@ -26,7 +26,18 @@ TSI_API int stop_signal();
 inline bool stop_requested() { return stop_signal() != 0; }
 /// Forgets a request, so that the next run of the same process goes to its end.
 TSI_API void clear_stop_request();
-/// Throws Interrupted naming `where` ("setting up model.A's flow") if a stop was requested.
-TSI_API void throw_if_stop_requested(const std::string& where);
+/// Throws Interrupted naming `where` ("setting up model.A's flow") if a stop was requested
+/// and polls are not paused.
+TSI_API void throw_if_stop_requested(const char* where);
+
+/// Pauses the polls inside the work (throw_if_stop_requested) while it lives: a run split over
+/// processes stops only where all of them agree, at a step's end, never one rank mid-step.
+class TSI_API StopPollsPaused {
+ public:
+  StopPollsPaused();
+  ~StopPollsPaused();
+  StopPollsPaused(const StopPollsPaused&) = delete;
+  StopPollsPaused& operator=(const StopPollsPaused&) = delete;
+};
 
 }  // namespace tsi

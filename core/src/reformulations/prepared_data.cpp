@@ -9,6 +9,7 @@
 #include "remainder.hpp"
 #include "sigma_nodes.hpp"
 #include "tsi/error.hpp"
+#include "tsi/stop_request.hpp"
 
 namespace tsi {
 namespace {
@@ -35,7 +36,7 @@ int trajectory_point_count(int order, bool remainder) { return remainder || orde
 /// higher degree allows a longer one (NLS, order 7 at eps = 1/16: 1.9e-12 off at 0.01, 7e-14 at
 /// 0.03), the fast rotations of a remainder do not (Klein-Gordon, order 7 at eps = 1/256:
 /// 1.7e-14 at 0.01, 1.5e-12 at 0.03). Measured on Henon-Heiles, NLS, the charged particle and
-/// Klein-Gordon at eps = 1e-4 .. 1 (docs/high-order.md).
+/// Klein-Gordon at eps = 1e-4 .. 1 (docs/benchmarks/high-order.md).
 Real trajectory_length(int m, bool remainder) { return m > 5 && !remainder ? 0.03 : 0.01; }
 // The order of the central quotients' data where the trajectory's sweeps diverge.
 constexpr int central_fallback_order = 4;
@@ -157,6 +158,7 @@ Matrix PreparedData::central_data(const Vector& v, Real s, int order) {
   Real last_correction = std::numeric_limits<Real>::infinity();
   order_reached_ = 1;
   for (int k = 2; k <= order; ++k) {
+    throw_if_stop_requested("preparing the two-scale initial data");  // an order can take seconds
     Matrix next = central_phi(u, k);
     const Vector next_u = v - grid_.evaluate(next, s);
     Matrix candidate = next;
@@ -183,7 +185,7 @@ Matrix PreparedData::central_phi(const Vector& u, int k) {
     // eps^k after the factor eps A, as the recursion needs. HOODESolver's forward quotient
     // with step eps^(k-2) divides rounding errors by eps^(k-2) at every level (about
     // (k-1)(k-2)/2 log10(1/eps) digits lost at order k); this step loses none up to order 6
-    // (docs/high-order.md has the measurement).
+    // (docs/benchmarks/high-order.md has the measurement).
     Vector g = f.col(0);
     if (remainder_.size()) g += remainder_.cwiseProduct(u);
     const Real d = std::pow(eps_, 0.25 * (k - 2));
@@ -217,7 +219,7 @@ Matrix PreparedData::trajectory_data(const Vector& v, Real s) {
   }
   // The trajectory's half length h: a fixed fraction of the time in which the averaged flow
   // at v moves by |v|. Shorter loses digits to the differentiation (eps D/h per level), longer
-  // to the interpolation of the trajectory (measured: docs/high-order.md).
+  // to the interpolation of the trajectory (measured: docs/benchmarks/high-order.md).
   const bool remainder = remainder_.size() > 0;
   const SigmaNodes nodes(trajectory_point_count(order_, remainder));
   Vector drift = f.col(0);
@@ -239,6 +241,7 @@ Matrix PreparedData::trajectory_data(const Vector& v, Real s) {
   std::vector<Vector> previous(m, Vector::Zero(grid_.size())), next(m, Vector(grid_.size())), drifts(m);
   Real last_correction = std::numeric_limits<Real>::infinity();
   for (int k = 2; k <= order_; ++k) {
+    throw_if_stop_requested("preparing the two-scale initial data");  // an order can take seconds
     trajectory_level(points, previous, nodes, h, next, drifts, k == order_ ? c : -1);
     Matrix candidate = grid_.all_modes(Eigen::Map<const Matrix>(next[c].data(), dim_, columns_));
     candidate.col(0) += v - grid_.evaluate(candidate, s);  // U(s) = v exactly
@@ -270,6 +273,7 @@ std::optional<std::vector<Vector>> PreparedData::averaged_trajectory(const Vecto
   Vector u = v;
   Real last_change = std::numeric_limits<Real>::infinity();
   for (int sweep = 1; sweep <= max_sweeps; ++sweep) {
+    throw_if_stop_requested("preparing the two-scale initial data");  // an order can take seconds
     trajectory_level(points, phi, nodes, h, next, drifts);
     const Vector next_u = v - grid_.evaluate(Eigen::Map<const Matrix>(next[c].data(), dim_, columns_), s);
     std::vector<Vector> next_points = picard_step(next_u, drifts, nodes, h);
@@ -297,6 +301,7 @@ void PreparedData::trajectory_level(const std::vector<Vector>& points, const std
   const auto phi = [&](int j) { return Eigen::Map<const Matrix>(previous[j].data(), dim_, columns_); };
   for (int i = 0; i < m; ++i) {
     if (only >= 0 && i != only) continue;
+    throw_if_stop_requested("preparing the two-scale initial data");
     grid_.nonlinear(previous[i], &points[i], next[i], phase_);  // f at c_i + previous_i(tau)
     Eigen::Map<Matrix> rhs(next[i].data(), dim_, columns_);
     drift[i] = rhs.col(0);

@@ -9,7 +9,7 @@ namespace tsi {
 
 struct SigmaNodes;
 
-/// How prepared data of order 2 and above is computed (docs/high-order.md, "Prepared data of
+/// How prepared data of order 2 and above is computed (docs/explanation/high-order.md, "Prepared data of
 /// any order").
 enum class DataMethod {
   automatic,  ///< SPEC.md's closed formulas for orders 1-3, the recursion along a trajectory above
@@ -62,7 +62,7 @@ class PreparedData {
   /// with D Phi^{k-1}(u) G a fourth-order central difference (see the definition).
   Matrix central_phi(const Vector& u, int k);
   /// The same recursion evaluated along one trajectory of the averaged flow, on which
-  /// D Phi^{k-1} G is d/dsigma (docs/high-order.md), as coefficients.
+  /// D Phi^{k-1} G is d/dsigma (docs/explanation/high-order.md), as coefficients.
   Matrix trajectory_data(const Vector& v, Real s);
   /// The averaged trajectory for trajectory_data: the points c_i = c(h x_i) of the trajectory
   /// through the base point u = v - Phi(u)(s), found with the data themselves (one order of

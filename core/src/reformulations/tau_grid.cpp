@@ -13,6 +13,7 @@
 
 #include "tsi/error.hpp"
 #include "tsi/phase.hpp"
+#include "tsi/stop_request.hpp"
 
 namespace tsi {
 namespace {
@@ -115,6 +116,7 @@ void TauGrid::bind_diagonal() {
 }
 
 void TauGrid::nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, Real phase) {
+  throw_if_stop_requested("evaluating the nonlinearity on the tau grid");  // seconds on a large grid
   ++*evaluations_;
   if (needs_diagonal_) {
     evaluate_into(Eigen::Map<const Matrix>(y.data(), dim_, columns_), phase, diagonal_);
@@ -361,6 +363,7 @@ Real TauGrid::norm_from_squares(Real squares) const {
 }
 
 Matrix TauGrid::f_coefficients(Matrix w) {
+  throw_if_stop_requested("evaluating the nonlinearity on the tau grid");  // seconds on a large grid
   ++*evaluations_;
   if (needs_diagonal_) set_diagonal(w.col(0));
   if (grid_field_->in_place()) {
@@ -374,6 +377,7 @@ Matrix TauGrid::f_coefficients(Matrix w) {
 }
 
 Matrix TauGrid::df_coefficients(Matrix w, Matrix z) {
+  throw_if_stop_requested("evaluating the nonlinearity on the tau grid");  // seconds on a large grid
   ++*evaluations_;
   if (needs_diagonal_) set_diagonal(w.col(0));
   model_->linear_flow(taus_, w);

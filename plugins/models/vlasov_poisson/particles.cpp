@@ -1,8 +1,10 @@
 #include "particles.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -12,6 +14,13 @@
 
 namespace tsi::pic {
 namespace {
+
+// x in the fewest digits that read back to the same double: 2.5e+153, not 2.5000000000000001e+153.
+std::string shortest(Real x) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, static_cast<double>(x)).ptr;
+  return std::string(text, end);
+}
 
 // A Real in [0, 1) from the generator's top 53 bits: the same on every platform
 // (std::uniform_real_distribution and std::generate_canonical are not specified that far).
@@ -63,17 +72,38 @@ RealVector read_particles(const std::string& file) {
   };
   RealVector u;
   if (std::filesystem::path(file).extension() == ".npy") {
+    // The header first: a file of the wrong shape or size is refused before its data are read.
+    NpyHeader header;
+    try {
+      header = read_npy_header(file);
+    } catch (const Error& e) {
+      throw ConfigError("model.particles", e.what());
+    }
+    const auto& shape = header.shape;
+    const std::string got = "an array of shape " + npy_shape_text(shape) + " ('" + header.descr + "')";
+    const char* const expected = "expected float64 of shape (N, 4), N >= 1: one row x1 x2 v1 v2 per particle";
+    // A flat array does not say how its values group into particles (x1 x2 v1 v2 each, or every x1 first).
+    if (shape.size() == 1)
+      throw refuse(got + ", " + expected + "; a flat array does not say how its values group into particles: save "
+                                           "p.reshape(-1, 4) if they go particle by particle");
+    if (shape.size() != 2 || shape[1] != 4)
+      throw refuse(got + ", " + expected +
+                   (shape.size() == 2 && shape[1] > 4
+                        ? "; weights or charges are not read: every particle has the weight |box| / N of a unit "
+                          "mean density, so keep the four columns x1 x2 v1 v2"
+                        : ""));
+    if (header.is_complex) throw refuse(got + ": complex values, " + expected);
+    if (shape[0] == 0) throw refuse(got + ": no particles, " + expected);
+    if (shape[0] > (std::uint64_t{1} << 28))
+      throw refuse(got + ": " + std::to_string(shape[0]) + " particles, expected at most 2^28");
     NpyArray array;
     try {
       array = read_npy(file);
     } catch (const Error& e) {
       throw ConfigError("model.particles", e.what());
     }
-    const auto& shape = array.header.shape;
-    const bool n_by_4 = shape.size() == 2 && shape[1] == 4, flat = shape.size() == 1 && shape[0] % 4 == 0;
-    if (array.header.is_complex || !(n_by_4 || flat) || array.header.count == 0)
-      throw refuse("an array of shape " + npy_shape_text(shape) + " (" + array.header.descr +
-                   "), expected float64 of shape (N, 4): x1 x2 v1 v2 per particle");
+    if (array.header.shape != shape)  // the file was replaced between the two reads
+      throw refuse("an array of shape " + npy_shape_text(array.header.shape) + ", " + expected);
     u = array.values.real();
   } else {
     std::error_code ec;
@@ -100,6 +130,27 @@ RealVector read_particles(const std::string& file) {
       throw refuse(what.str());
     }
   return u;
+}
+
+void check_energies(const RealVector& u, const Geometry& geometry, const std::string& file) {
+  const Real weight = geometry.weight();
+  // The largest |v| whose w |v|^2 / 2 is a finite double.
+  const Real limit = std::sqrt(2.0 / weight) * std::sqrt(std::numeric_limits<Real>::max());
+  Real kinetic = 0.0;
+  for (Index k = 0; k < u.size() / 4; ++k) {
+    const Real v1 = u(4 * k + 2), v2 = u(4 * k + 3), energy = 0.5 * weight * (v1 * v1 + v2 * v2);
+    kinetic += energy;
+    if (std::isfinite(energy) && std::isfinite(kinetic)) continue;
+    std::ostringstream what;
+    what << file << ": particle " << k << " has |v| = " << shortest(std::hypot(v1, v2)) << " (v1 = " << shortest(v1)
+         << ", v2 = " << shortest(v2) << "): "
+         << (std::isfinite(energy) ? "with it the total kinetic energy sum w |v|^2 / 2" : "its kinetic energy w |v|^2 / 2")
+         << " overflows to inf (w = |box| / N = " << shortest(weight)
+         << "), and the energy W and the run's monitors with it";
+    what.precision(3);
+    what << "; expected velocities of finite energy (|v| well below " << limit << "; a file in other units?)";
+    throw ConfigError("model.particles", what.str());
+  }
 }
 
 void check_positions(const RealVector& u, const Geometry& geometry, const std::string& file) {

@@ -20,10 +20,16 @@ enum class Distribution {
 /// every machine with IEEE doubles and a correctly rounded libm).
 RealVector sample_particles(const Geometry& geometry, Distribution distribution, Real alpha, std::uint64_t seed);
 
-/// The particles of a file: `.npy` (float64, N x 4 or 4N values), any other name the peer's
-/// raw layout (a multiple of 32 bytes). A tsi::ConfigError naming model.particles for a file
-/// that cannot be read, of the wrong size, or with values that are not finite.
+/// The particles of a file: `.npy` (float64 or float32 of shape (N, 4); a flat array, which does
+/// not say how its values group, is refused), any other name the peer's raw layout (a multiple
+/// of 32 bytes). A tsi::ConfigError naming model.particles for a file that cannot be read, of
+/// the wrong shape or size, or with values that are not finite.
 RealVector read_particles(const std::string& file);
+
+/// Refuses (a tsi::ConfigError naming model.particles, the particle and its |v|) velocities
+/// whose kinetic energy w |v|^2 / 2, or whose sum over the particles, overflows: the energy W
+/// would be inf and its monitors NaN from the first step.
+void check_energies(const RealVector& u, const Geometry& geometry, const std::string& file);
 
 /// Refuses (a tsi::ConfigError naming model.particles) particles whose positions are farther
 /// than one box length outside the box, [-L, 2L) per coordinate: a file in other units or of

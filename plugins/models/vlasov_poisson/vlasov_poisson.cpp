@@ -16,6 +16,7 @@
 #include "particles.hpp"
 #include "pic_field.hpp"
 #include "tsi/error.hpp"
+#include "tsi/memory.hpp"
 #include "tsi/model.hpp"
 #include "tsi/params.hpp"
 #include "tsi/plugin.hpp"
@@ -342,14 +343,32 @@ void register_vlasov_poisson(tsi::Registry& registry) {
     g.k_x = p.number("k_x");
     g.k_y = p.number("k_y");
     g.shape = p.string("shape") == "cic" ? tsi::pic::Shape::cic : tsi::pic::Shape::m6;
+    // The particles come from model.particles alone, where their file is checked (shape, finite
+    // values, positions, energies); model.u0 would replace them unchecked.
+    if (p.has("u0")) {
+      const tsi::Json& u0 = p.raw().at("u0");
+      throw tsi::ConfigError(
+          "model.u0",
+          (u0.is_string() ? "got the file \"" + u0.get<std::string>() + "\""
+                          : "got " + std::to_string(u0.is_array() ? u0.size() : 1) + " values") +
+              ": vlasov-poisson-2d takes its initial particles from model.particles, not model.u0: give them there "
+              "as a .npy file of shape (N, 4), x1 x2 v1 v2 per particle (a run's state.npy is one), "
+              "and leave model.u0 out");
+    }
     tsi::RealVector particles;
     const tsi::Json& given = p.raw().at("particles");
     if (given.is_string()) {
       particles = tsi::pic::read_particles(given.get<std::string>());
       g.particles = particles.size() / 4;
       tsi::pic::check_positions(particles, g, given.get<std::string>());
+      tsi::pic::check_energies(particles, g, given.get<std::string>());
     } else {
       g.particles = static_cast<Index>(given.get<double>());
+      // Sampled before the run sizes its state (n_tau such sets, checked next): refused here
+      // when the particles alone do not fit, before they are allocated and sampled.
+      tsi::check_allocation("model.particles", 32.0 * static_cast<double>(g.particles),
+                            std::to_string(g.particles) +
+                                " particles (x1 x2 v1 v2 in float64, sampled before the run's state of n_tau such sets)");
       const auto distribution =
           p.string("distribution") == "peer" ? tsi::pic::Distribution::peer : tsi::pic::Distribution::landau;
       particles = tsi::pic::sample_particles(g, distribution, p.number("alpha"), static_cast<std::uint64_t>(p.integer("seed")));

@@ -7,7 +7,7 @@
 // it has Gauss collocation's order 2 s; uniformly in eps it is declared of order 2 only: the
 // maximum of its errors over eps falls at order 4 for s = 3 on Henon-Heiles (16 eps from 1 to
 // 1e-6), NLS, the charged particle and Klein-Gordon, but at 3.2 on the FPUT example near a
-// step-size resonance (docs/high-order.md).
+// step-size resonance (docs/explanation/high-order.md).
 #include <cmath>
 #include <memory>
 #include <vector>

@@ -150,7 +150,7 @@ void register_composition(tsi::Registry& registry) {
   entry.traits.order = 2;
   entry.traits.classical_order = 4;
   // At step-size resonances of its substeps the error is bounded but need not fall: NLS at
-  // eps = 0.01 (n_x = 16), 5.2e-4, 6.8e-5, 6.2e-5, 6.9e-5 for h = 1/4 .. 1/32 (docs/high-order.md).
+  // eps = 0.01 (n_x = 16), 5.2e-4, 6.8e-5, 6.2e-5, 6.9e-5 for h = 1/4 .. 1/32 (docs/benchmarks/high-order.md).
   entry.traits.resonant_order = 0;
   entry.traits.symmetric = true;
   entry.traits.implicit = true;
@@ -163,7 +163,7 @@ void register_composition(tsi::Registry& registry) {
     const Method& m = method_named(params.value("method", std::string("triple-jump")));
     // Order m.order at a fixed eps (h -> 0), but only 2 uniformly: the base's leading error
     // term depends on the phase h L of each substep, so the substeps' errors do not cancel
-    // between eps ~ h and eps ~ h / 100 whatever the data (docs/high-order.md has the
+    // between eps ~ h and eps ~ h / 100 whatever the data (docs/benchmarks/high-order.md has the
     // measurement: data of order 2 to 6 give the same errors there). Data of the classical
     // order keep U smooth enough in tau for it at eps ~ 1 (charged particle, eps = 1,
     // n_tau = 64: 3.2e-8 with order-2 data, 3.7e-11 with order 4, at h = 1/128).

@@ -84,7 +84,7 @@ void register_fd(tsi::Registry& registry) {
   // With a remainder the data's O(eps^3) defect grows with eps |R| (Klein-Gordon, n_x = 16:
   // eps max A_k = 0.28 at eps = 1e-2, 0.71 at 3e-2), and the Crank-Nicolson fraction turns
   // it by a wrong phase while h k / eps ~ 1: with order 3 the maximum over eps in [1e-2, 1] falls at 1.4 to
-  // 1.6 from h = 1/16 to 1/512, with order 4 at 1.83 to 1.97 (docs/high-order.md).
+  // 1.6 from h = 1/16 to 1/512, with order 4 at 1.83 to 1.97 (docs/benchmarks/high-order.md).
   entry.traits.remainder_data_order = 4;
   entry.traits.reformulations = {"filtered", "two-scale"};
   entry.create = [](const tsi::Params&) { return tsi::make_scheme<Fd>(std::monostate{}); };

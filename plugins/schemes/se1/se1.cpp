@@ -92,7 +92,7 @@ void register_se1(tsi::Registry& registry) {
   entry.traits.order = 2;
   entry.traits.symmetric = true;
   // At step-size resonances h = k pi eps the error falls at order 1 only (Henon-Heiles, k = 1:
-  // 4.0e-4, 2.0e-4, 1.0e-4, 4.6e-5 at h = 1/16 .. 1/128; docs/high-order.md).
+  // 4.0e-4, 2.0e-4, 1.0e-4, 4.6e-5 at h = 1/16 .. 1/128; docs/benchmarks/high-order.md).
   entry.traits.resonant_order = 1;
   entry.traits.implicit = true;
   entry.traits.needs_diagonal_linear_part = true;
