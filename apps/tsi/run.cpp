@@ -60,8 +60,19 @@ Assembly reference_assembly(const Json& config, const Registry& registry, const 
   options.context = settings.context;
   Json reformulation = {{"name", config["reference"]["reformulation"]}};
   if (config["reference"].value("n_tau", Json()).is_number()) reformulation["n_tau"] = config["reference"]["n_tau"];
-  return assemble_config({{"model", config["model"]}, {"reformulation", reformulation}, {"scheme", scheme_section}},
-                         registry, options);
+  try {
+    return assemble_config({{"model", config["model"]}, {"reformulation", reformulation}, {"scheme", scheme_section}},
+                           registry, options);
+  } catch (const ConfigError& e) {
+    // The reference's reformulation is the reference section's: reformulation.n_tau here is
+    // reference.n_tau (or the default it took), reformulation.name reference.reformulation.
+    const std::string& field = e.field();
+    if (field.rfind("reformulation.", 0) != 0) throw;
+    const std::string key = field.substr(std::string("reformulation.").size());
+    const std::string message = std::string(e.what()).substr(field.size() + 2);
+    throw ConfigError("reference." + (key == "name" ? std::string("reformulation") : key),
+                      message + (config["reference"].contains(key) ? "" : " (the reference's default)"));
+  }
 }
 
 // The steps a reference will take, before it starts: an adaptive solver at least
