@@ -334,7 +334,7 @@ class StudyUxTests(unittest.TestCase):
 
     def test_an_unknown_model_mentions_plugins(self):
         with self.assertRaises(tsi.ConfigError) as caught:
-            tsi.run(with_(HH, model={"name": "fput"}))
+            tsi.run(with_(HH, model={"name": "fput-example"}))  # the example plugin's model, not loaded
         self.assertEqual(caught.exception.field, "model.name")
         self.assertIn("--plugin FILE", str(caught.exception))
         self.assertIn("tsi.load_plugin", str(caught.exception))

@@ -144,7 +144,7 @@ TEST_CASE("check: every shipped scheme passes on every shipped model, or is unde
   // cannot decide.
   const std::vector<std::vector<std::string>> lists = {
       {"--eps", "1e-2"}, {"--eps", "1e-3"}, {"--eps", "1e-4"}, {"--eps", "1e-2", "--eps", "1e-3", "--eps", "1e-4"}};
-  for (const char* model : {"henon-heiles", "charged-particle", "klein-gordon", "matrix"}) {
+  for (const char* model : {"henon-heiles", "charged-particle", "klein-gordon", "matrix", "fput"}) {
     for (const auto& list : lists) {
       std::vector<std::string> command = {"check", model};
       command.insert(command.end(), list.begin(), list.end());

@@ -1,5 +1,5 @@
 // The plugin SDK end to end: `cmake --install` into a temporary prefix, then every example
-// plugin the prefix ships (share/tsi/examples/plugins: the Hamiltonian model fput, the scheme
+// plugin the prefix ships (share/tsi/examples/plugins: the Hamiltonian model fput-example, the scheme
 // expmid, the general-class model van_der_pol) configured and built from there, in a build
 // directory of its own, against that prefix alone (find_package(tsi)), loaded by the installed
 // runner, passing `tsi check`, and run with a measured order; and the public headers on their
@@ -132,7 +132,8 @@ TEST_CASE("sdk: the installed example plugins build against an installed tsi and
     REQUIRE(r.exit_code == 0);
   }
   for (const char* file :
-       {"bin/tsi", "lib/libtsi_core.so", "lib/tsi/plugins/tsi_henon_heiles.so", "lib/tsi/plugins/tsi_se1.so",
+       {"bin/tsi", "lib/libtsi_core.so", "lib/tsi/plugins/tsi_henon_heiles.so", "lib/tsi/plugins/tsi_fput.so",
+        "lib/tsi/plugins/tsi_se1.so",
         "lib/tsi/plugins/tsi_rk78.so", "include/tsi/model.hpp", "include/tsi/plugin.hpp",
         "lib/cmake/tsi/tsiConfig.cmake", "lib/cmake/tsi/tsiConfigVersion.cmake",
         "lib/cmake/tsi/tsiTargets.cmake", "lib/cmake/tsi/TsiPlugin.cmake", "include/tsi/assembly.hpp",
@@ -167,12 +168,14 @@ TEST_CASE("sdk: the installed example plugins build against an installed tsi and
   const std::string plugin_path = fs::canonical(plugin).string();
 
   // 4. `tsi list` shows the external model, the file that provided it, and marks it as the
-  //    --plugin file's (the shipped models stay unmarked).
+  //    --plugin file's (the shipped models stay unmarked). The example registers as
+  //    fput-example beside the shipped fput, the same model: both load in one process.
   {
     const t::CommandResult r = run(tsi, {"--plugin", plugin.string(), "list", "models"});
     INFO(r.describe());
     REQUIRE(r.exit_code == 0);
-    CHECK(mentions(r.out, "fput (fpu, fermi-pasta-ulam)"));
+    CHECK(mentions(r.out, "  fput-example  Fermi-Pasta-Ulam-Tsingou chain"));
+    CHECK(mentions(r.out, "  fput (fpu, fermi-pasta-ulam)  Fermi-Pasta-Ulam-Tsingou chain"));
     CHECK(mentions(r.out, "dim 4m  [from tsi_fput.so]\n"));
     CHECK(mentions(r.out, "provided by " + plugin_path));
     CHECK(mentions(r.out, "default n_tau 64"));
@@ -189,16 +192,20 @@ TEST_CASE("sdk: the installed example plugins build against an installed tsi and
     t::CommandEnv env;
   } series[] = {{1e-2, {"--plugin", plugin.string()}, {}}, {1e-4, {}, by_path}};
   for (const auto& s : series) {
-    const Series fput = error_series(tsi, tmp, "fput", s.eps, "se1", s.plugin_args, s.env);
+    const Series fput = error_series(tsi, tmp, "fput-example", s.eps, "se1", s.plugin_args, s.env);
     CAPTURE(s.eps);
     CAPTURE(fput.errors[0]);
     CAPTURE(fput.errors[3]);
     CHECK(std::abs(fput.order - 2.0) <= 0.2);  // measured 1.93 (eps = 1e-2), 1.97 (1e-4)
     CHECK(fput.errors[3] < 1e-3);              // measured 4.9e-4, 5.6e-4
+    // The shipped fput, loaded in the same process, computes the same numbers.
+    const Series shipped = error_series(tsi, tmp, "fput", s.eps, "se1", s.plugin_args, s.env);
+    for (size_t i = 0; i < shipped.errors.size(); ++i)
+      CHECK(std::abs(shipped.errors[i] - fput.errors[i]) <= 1e-10 * fput.errors[i]);
   }
 
   // 6. The plugin passes the conformance checks, run by the example's own ctest (tsi::tsi).
-  check_example(build, "fput: all");
+  check_example(build, "fput-example: all");
 
   // 7. The scheme example (docs/tutorials/scheme-plugin.md) builds the same way, passes its checks on
   //    the shipped Henon-Heiles model, and is second order there at eps = 1e-4 (away from the

@@ -21,6 +21,9 @@
 // I = <Mu, u> / (2 eps) = 1/2 |y1|^2 + omega^2/2 |x1|^2 is GNI's. Physical variables (u0 in a
 // config, u_final, errors) are GNI's (x0, x1, y0, y1). Default initial value as in GNI
 // (m = 3): x0_1 = 1, y0_1 = 1, x1_1 = 1/omega = eps, y1_1 = 1, all others 0.
+//
+// tsi ships the same model as "fput" (plugins/models/fput); this example registers as
+// "fput-example", so that both load in one process (a name or alias is taken only once).
 #include <cmath>
 #include <memory>
 
@@ -159,8 +162,7 @@ class Fput final : public tsi::Model, public tsi::HamiltonianStructure, public t
 
 void register_fput(tsi::Registry& registry) {
   tsi::ModelEntry entry;
-  entry.info.name = "fput";
-  entry.info.aliases = {"fpu", "fermi-pasta-ulam"};
+  entry.info.name = "fput-example";
   entry.info.summary =
       "Fermi-Pasta-Ulam-Tsingou chain, m stiff springs of frequency 1/eps (GNI I.5, XIII), dim 4m";
   entry.info.params = {
@@ -174,4 +176,4 @@ void register_fput(tsi::Registry& registry) {
 
 }  // namespace
 
-TSI_PLUGIN("fput", register_fput)
+TSI_PLUGIN("fput-example", register_fput)
