@@ -61,6 +61,28 @@ Vector exact(double t) {
   return u;
 }
 
+// The recorder's verdict after steps 0 .. 4 of h = 0.25 with an invariant that is 2 while
+// |u_2| < 0.3 (t < 0.305) and `beyond` after: a declared invariant that stops being a number
+// while the state stays finite (a particle energy sum w |v|^2 / 2 that overflows).
+struct Outcome {
+  long stopped_at = -1;
+  std::string status, message;
+  Json invariant;
+};
+
+Outcome record(double beyond) {
+  Setup s({{"W", "2, then beyond", [beyond](const Vector& u) { return std::abs(u(1).real()) < 0.3 ? 2.0 : beyond; }}});
+  tsi::app::RunRecorder recorder(*s.model, *s.direct, exact(0.0), config(0.25, 1.0));
+  Outcome out;
+  for (long n = 0; n <= 4 && out.stopped_at < 0; ++n)
+    if (!recorder.observe(n, 0.25 * static_cast<double>(n), s.direct->prepare(exact(0.25 * static_cast<double>(n)))))
+      out.stopped_at = n;
+  out.status = recorder.status();
+  out.message = recorder.message();
+  out.invariant = recorder.invariants_json()["W"];
+  return out;
+}
+
 }  // namespace
 
 TEST_CASE("recorder: a declared invariant gets a value and a change column, relative or absolute") {
@@ -157,4 +179,27 @@ TEST_CASE("recorder: invariants and monitors run every output.every steps, a fin
   CHECK(watched.message().find("last recorded state is from t = 0.7 (step 7") != std::string::npos);
   CHECK(watched.steps() == 7);
   CHECK(watched.u_last() == exact(time(7)));
+}
+
+TEST_CASE("recorder: a declared invariant that turns NaN stops the run, and its max_change is NaN, not 0") {
+  const Outcome o = record(std::numeric_limits<double>::quiet_NaN());
+  CHECK(o.stopped_at == 2);  // t = 0.5: |sin 0.5| = 0.48
+  CHECK(o.status == "blow-up");
+  CHECK(o.message.find("the invariant W = nan at t = 0.5 (step 2) is not a finite number") != std::string::npos);
+  CHECK(std::isnan(o.invariant["max_change"].get<double>()));
+}
+
+TEST_CASE("recorder: a declared invariant that overflows to inf stops the run, naming it") {
+  const Outcome o = record(std::numeric_limits<double>::infinity());
+  CHECK(o.stopped_at == 2);
+  CHECK(o.status == "blow-up");
+  CHECK(o.message.find("the invariant W = inf at t = 0.5 (step 2)") != std::string::npos);
+  CHECK(std::isinf(o.invariant["max_change"].get<double>()));
+}
+
+TEST_CASE("recorder: a finite declared invariant runs to the end with its largest change") {
+  const Outcome o = record(3.0);
+  CHECK(o.stopped_at == -1);
+  CHECK(o.status == "running");
+  CHECK(o.invariant["max_change"].get<double>() == 0.5);  // |3 - 2| / 2
 }
