@@ -38,7 +38,7 @@ function(tsi_add_plugin name)
   endif()
   # sqrt and friends need not set errno (nothing reads it), so loops over tau points that
   # call them can be vectorised: the charged particle's field is 13% faster.
-  target_compile_options(${target} PRIVATE $<$<CXX_COMPILER_ID:GNU,Clang>:-fno-math-errno>)
+  target_compile_options(${target} PRIVATE $<$<AND:$<COMPILE_LANGUAGE:CXX>,$<CXX_COMPILER_ID:GNU,Clang>>:-fno-math-errno>)
 
   if(ARG_OUTPUT_DIRECTORY)
     set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${ARG_OUTPUT_DIRECTORY})

@@ -134,6 +134,11 @@ int main(int argc, char** argv) {
   const std::string max_steps_help =
       "refuse a run (or its reference) estimated to take more than N steps, before it starts (default 1e9)";
   run->add_option("--max-steps", max_steps, max_steps_help);
+  std::string device = "cpu";
+  run->add_option("--device", device,
+                  "where the steps run: cpu, or cuda (a build with TSI_WITH_CUDA: the two-scale NLS with se1 or eab "
+                  "on the GPU; docs/how-to/gpu.md)")
+      ->check(CLI::IsMember({"cpu", "cuda"}));
   bool dry_run = false, quiet = false;
   run->add_flag("--dry-run", dry_run, "check the config as a run would and print its steps, memory and reference; "
                                       "run and write nothing");
@@ -217,6 +222,7 @@ int main(int argc, char** argv) {
     tsi::app::RunSettings settings = tsi::app::RunSettings::from_flags(
         threads > 0 ? threads : run->parsed() && !processes ? cores : 1, fft_threads, max_steps);
     settings.context.collective = processes.get();
+    settings.device = device;
     tsi::Registry registry;
     tsi::PluginLoader loader(registry);
     for (const auto& warning : tsi::app::load_plugins(loader, registry, plugin_files))

@@ -19,6 +19,8 @@
 #include "run_recorder.hpp"
 #include "tsi/assembly.hpp"
 #include "tsi/collective.hpp"
+#include "tsi/device.hpp"
+#include "tsi/device_kernels.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/driver.hpp"
 #include "tsi/error.hpp"
@@ -540,6 +542,44 @@ std::vector<double> checked_output_times(const Json& config) {
 
 }  // namespace
 
+namespace {
+
+// --device cuda: what runs on the device, refused before anything runs otherwise.
+void check_device_run(const Json& config, const Assembly& assembly, const RunSettings& settings) {
+  if (!device::available())
+    throw ConfigError("--device", "got \"cuda\", but this build of tsi has no CUDA backend; configure with "
+                                  "-DTSI_WITH_CUDA=ON on a machine with the CUDA toolkit (docs/how-to/gpu.md)");
+  if (device::device_count() == 0)
+    throw ConfigError("--device", fmt::format("got \"cuda\", but {}", device::describe()));
+  if (settings.context.collective)
+    throw ConfigError("--device", "got \"cuda\" with --split; a split run's shares stay on the CPU");
+  const std::string& reformulation = assembly.reformulation_entry->info.name;
+  if (reformulation != "two-scale")
+    throw ConfigError("reformulation.name", fmt::format("got \"{}\" with --device cuda; expected \"two-scale\" (the "
+                                                        "device runs the two-scale problem)", reformulation));
+  if (!dynamic_cast<const DeviceKernels*>(assembly.model.get()))
+    throw ConfigError("model.name", fmt::format("got \"{}\" with --device cuda; expected a model with device kernels: "
+                                                "nls", assembly.model_entry->info.name));
+  // The schemes whose steps were checked against the CPU on a device (docs/how-to/gpu.md): a
+  // scheme that read a state's entries on the host would read a stale copy there.
+  const std::string& scheme = assembly.scheme_entry->info.name;
+  if (scheme != "se1" && scheme != "eab")
+    throw ConfigError("scheme.name", fmt::format("got \"{}\" with --device cuda; expected one of the schemes checked "
+                                                 "on the device: se1, eab", scheme));
+  const Json& sconf = config["scheme"];
+  if (sconf.contains("solver") && sconf["solver"] != "picard")
+    throw ConfigError("scheme.solver", fmt::format("got {} with --device cuda; expected \"picard\"",
+                                                   sconf["solver"].dump()));
+  const Json& rconf = config["reformulation"];
+  if (rconf.contains("reprepare") && rconf["reprepare"] != "never")
+    throw ConfigError("reformulation.reprepare", fmt::format("got {} with --device cuda; expected \"never\"",
+                                                             rconf["reprepare"].dump()));
+  if (!checked_output_times(config).empty())
+    throw ConfigError("output.times", "dense output is not available with --device cuda; expected none");
+}
+
+}  // namespace
+
 RunPlan plan_run(const Json& config, const Registry& registry, const RunSettings& settings, bool check_reference) {
   RunPlan plan;
   // Construction: bad input (a model's own checks, u0 of the wrong shape, a run that cannot fit
@@ -604,6 +644,7 @@ RunPlan plan_run(const Json& config, const Registry& registry, const RunSettings
         "reformulation.n_tau = {} cannot hold the tau harmonics of this model's degree-{} nonlinearity "
         "(up to |k| = {}: n_tau >= {} needed); the result aliases them",
         rconf["n_tau"].get<long>(), degree, degree + 1, 2 * (degree + 2)));
+  if (settings.device == "cuda") check_device_run(config, assembly, settings);
   plan.steps = step_count(config);
   checked_output_times(config);
   return plan;
@@ -672,6 +713,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   };
   const TwoScaleDiagnostics* diagnostics = reformulation->two_scale_diagnostics();
   result["threads"] = diagnostics ? diagnostics->threads() : 1;  // on the tau grid (tsi --threads)
+  result["device"] = settings.device == "cuda" ? "cuda: " + device::describe() : "cpu";  // where the steps ran
   try {
     Vector y = reformulation->prepare(u0);
     const int data_order = diagnostics ? diagnostics->data_order_reached() : 0;
@@ -684,6 +726,9 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
             data_order, rconf["initial_data_order"].get<int>(), model->eps()));
     }
     stepper = &assembly.bind(config["time"]["h"].get<double>());
+    // --device cuda: the steps on the device, y back on the host when the scope closes.
+    std::optional<device::Scope> on_device;
+    if (settings.device == "cuda") on_device.emplace(y);
     integrate(*stepper, y, n_steps, [&](long n, Real t, const Vector& state) {
       const bool go_on = recorder.observe(n, t, state);
       if (go_on && dense) dense->observe(n, state);  // a finite state only
@@ -698,6 +743,7 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
       if (go_on && state_every > 0 && (split || !stream_dir.empty()) && (n % state_every == 0 || n == n_steps)) {
         // The state as a file a run can start from (written to a temporary file, then renamed),
         // and result.json's checkpoint says at which time it is.
+        const device::HostView host(state);
         Vector x = whole(model->to_physical(reformulation->read_back(state, t)));
         if (!stream_dir.empty()) {
           model->canonicalize_physical(x);

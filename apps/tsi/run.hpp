@@ -62,6 +62,8 @@ inline constexpr double default_max_steps = 1e9;
 struct RunSettings {
   Context context;                       ///< --threads (its tau grid), --fft-threads (FFTW's own)
   double max_steps = default_max_steps;  ///< --max-steps
+  /// --device: "cpu", or "cuda" (the steps on the GPU: tsi/device.hpp; a build with TSI_WITH_CUDA).
+  std::string device = "cpu";
   /// The settings of these flags: a ConfigError naming the flag for a value out of range
   /// (threads below 1; a step limit outside 1 .. 1e12).
   static RunSettings from_flags(int tau_grid_threads, int fft_threads, double max_steps);

@@ -16,6 +16,7 @@
 
 #include "config.hpp"
 #include "tsi/algebra.hpp"
+#include "tsi/device.hpp"
 #include "tsi/error.hpp"
 
 namespace tsi::app {
@@ -160,6 +161,7 @@ bool RunRecorder::observe(long n, Real t, const Vector& y) {
                            t, n, t_, steps_, every_);
     return false;
   }
+  const device::HostView host(y);  // --device cuda: y's entries back on the host, and what follows computed there
   Vector u = reformulation_.read_back(y, t);
   Real values[3] = {0, 0, 0};
   if (hamiltonian_) values[0] = model_.energy(u), values[1] = model_.oscillatory_energy(u), values[2] = model_.mass(u);

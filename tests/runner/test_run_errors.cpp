@@ -67,6 +67,25 @@ CommandResult run_config(const Json& config, const std::vector<std::string>& ext
 
 TEST_SUITE("tsi_runner_tests") {
 
+TEST_CASE("run errors: --device cuda is refused before anything runs where the device cannot take the run") {
+  // A build without CUDA, or a machine without a device, names --device; a CUDA build on a GPU
+  // names what the device does not run (here: the filtered problem).
+  const Json nls = {{"model", {{"name", "nls"}, {"eps", 0.1}, {"n_x", 16}}},
+                    {"reformulation", {{"name", "filtered"}}},
+                    {"scheme", {{"name", "se1"}}},
+                    {"time", {{"h", 0.1}, {"t_end", 0.2}}}};
+  const CommandResult r = run_config(nls, {"--device", "cuda"});
+  INFO(r.describe());
+  CHECK(r.exit_code == 2);
+  CHECK((contains(r.err, "tsi: error: --device: got \"cuda\", but ") ||
+         contains(r.err, "tsi: error: reformulation.name: got \"filtered\" with --device cuda")));
+  const CommandResult unknown = run_config(nls, {"--device", "gpu"});
+  CHECK(unknown.exit_code == 2);
+  CHECK(contains(unknown.err, "--device: gpu not in {cpu,cuda}"));
+  const CommandResult cpu = run_config(nls, {"--device", "cpu"});  // the default, named
+  CHECK(cpu.exit_code == 0);
+}
+
 TEST_CASE("run errors: an unknown model lists the valid models") {
   check_bad_input(run_example_with({"model.name=no-such-model"}), "model.name",
                   {"unknown model", "\"no-such-model\"", "henon-heiles", "hh", "from a plugin needs the plugin loaded: --plugin FILE"});

@@ -4,6 +4,7 @@
 #include <initializer_list>
 #include <span>
 
+#include "tsi/device.hpp"
 #include "tsi/diagonal.hpp"
 #include "tsi/export.hpp"
 #include "tsi/function_ref.hpp"
@@ -15,34 +16,54 @@
 /// two-scale transforms and the model kernels, and no scheme. Every function is one fused pass
 /// over the data (Eigen's vectorised complex products, without std::complex's NaN checks),
 /// entrywise so that `out` may alias an input, and allocates only when `out` has the wrong size.
+/// While a tsi::device::Scope is open on the thread, each function runs on the device instead
+/// (tsi/device.hpp: the same operations, one kernel each).
 namespace tsi::algebra {
 
 /// out = x.
-inline void copy(const Vector& x, Vector& out) { out = x; }
+inline void copy(const Vector& x, Vector& out) {
+  if (device::current()) return device::copy(x, out);
+  out = x;
+}
 
 /// Exchanges a and b (no copy).
 inline void swap(Vector& a, Vector& b) { a.swap(b); }
 
 /// out = 0, with n entries.
-inline void set_zero(Index n, Vector& out) { out.setZero(n); }
+inline void set_zero(Index n, Vector& out) {
+  if (device::current()) return device::set_zero(n, out);
+  out.setZero(n);
+}
 
 /// out = a x + b y (out may alias x or y).
 inline void axpby(Real a, const Vector& x, Real b, const Vector& y, Vector& out) {
+  if (device::current()) return device::axpby(a, x, b, y, out);
   out = a * x + b * y;
 }
 
 /// y += a x.
 inline void axpy(Real a, const Vector& x, Vector& y) {
+  if (device::current()) return device::axpby(a, x, Real(1), y, y);
   y += a * x;
 }
 
 /// out = d . x (entrywise: the action of a diagonal operator; out may alias x).
 inline void diagonal_multiply(const Vector& d, const Vector& x, Vector& out) {
+  if (device::current()) {
+    const Vector* ds[] = {&d};
+    const Vector* xs[] = {&x};
+    return device::vector_combination(nullptr, ds, xs, out);
+  }
   out = d.cwiseProduct(x);
 }
 
 /// out = x + d . y: an implicit stage's map, base + h phi1(hL) N (out may alias x or y).
 inline void diagonal_multiply_add(const Vector& x, const Vector& d, const Vector& y, Vector& out) {
+  if (device::current()) {
+    const Vector* ds[] = {&d};
+    const Vector* xs[] = {&y};
+    return device::vector_combination(&x, ds, xs, out);
+  }
   out = x + d.cwiseProduct(y);
 }
 
@@ -50,12 +71,22 @@ inline void diagonal_multiply_add(const Vector& x, const Vector& d, const Vector
 /// (out may alias x1 or x2).
 inline void diagonal_combination(const Vector& d1, const Vector& x1, const Vector& d2, const Vector& x2,
                                  Vector& out) {
+  if (device::current()) {
+    const Vector* ds[] = {&d1, &d2};
+    const Vector* xs[] = {&x1, &x2};
+    return device::vector_combination(nullptr, ds, xs, out);
+  }
   out = d1.cwiseProduct(x1) + d2.cwiseProduct(x2);
 }
 
 /// out = d1 . x1 + d2 . x2 + d3 . x3 (multistep schemes; out may alias any x).
 inline void diagonal_combination(const Vector& d1, const Vector& x1, const Vector& d2, const Vector& x2,
                                  const Vector& d3, const Vector& x3, Vector& out) {
+  if (device::current()) {
+    const Vector* ds[] = {&d1, &d2, &d3};
+    const Vector* xs[] = {&x1, &x2, &x3};
+    return device::vector_combination(nullptr, ds, xs, out);
+  }
   out = d1.cwiseProduct(x1) + d2.cwiseProduct(x2) + d3.cwiseProduct(x3);
 }
 
@@ -64,6 +95,7 @@ inline void diagonal_combination(const Vector& d1, const Vector& x1, const Vecto
 /// in a block of entries that stays in cache, in the order given. out may alias start or any x_j.
 inline void diagonal_linear_combination(const Vector* start, std::span<const Vector* const> d,
                                         std::span<const Vector* const> x, Vector& out) {
+  if (device::current()) return device::vector_combination(start, d, x, out);
   const Index n = start ? start->size() : x.front()->size();
   out.resize(n);
   constexpr Index block = 256;
@@ -113,6 +145,12 @@ inline void for_run_pieces(Index r, Index i0, Index i1, Piece&& piece) {
 
 /// out = d . x (out may alias x).
 inline void diagonal_multiply(const Diagonal& d, const Vector& x, Vector& out) {
+  if (device::current()) {
+    const Diagonal* ds[] = {&d};
+    const Real none[] = {0};
+    const Vector* xs[] = {&x};
+    return device::linear_combination(nullptr, ds, none, xs, out);
+  }
   out.resize(x.size());
   const Index r = d.run();
   const Vector& v = d.values();
@@ -127,6 +165,12 @@ inline void diagonal_multiply(const Diagonal& d, const Vector& x, Vector& out) {
 
 /// out = x + d . y (out may alias x or y).
 inline void diagonal_multiply_add(const Vector& x, const Diagonal& d, const Vector& y, Vector& out) {
+  if (device::current()) {
+    const Diagonal* ds[] = {&d};
+    const Real none[] = {0};
+    const Vector* xs[] = {&y};
+    return device::linear_combination(&x, ds, none, xs, out);
+  }
   out.resize(x.size());
   const Index r = d.run();
   const Vector& v = d.values();
@@ -144,6 +188,12 @@ inline void diagonal_multiply_add(const Vector& x, const Diagonal& d, const Vect
 /// out = d1 . x1 + d2 . x2 (out may alias x1 or x2).
 inline void diagonal_combination(const Diagonal& d1, const Vector& x1, const Diagonal& d2, const Vector& x2,
                                  Vector& out) {
+  if (device::current()) {
+    const Diagonal* ds[] = {&d1, &d2};
+    const Real none[] = {0, 0};
+    const Vector* xs[] = {&x1, &x2};
+    return device::linear_combination(nullptr, ds, none, xs, out);
+  }
   out.resize(x1.size());
   const Index r = detail::common_run({&d1, &d2});
   const Vector &v1 = d1.values(), &v2 = d2.values();
@@ -164,6 +214,12 @@ inline void diagonal_combination(const Diagonal& d1, const Vector& x1, const Dia
 /// out = d1 . x1 + d2 . x2 + d3 . x3 (out may alias any x).
 inline void diagonal_combination(const Diagonal& d1, const Vector& x1, const Diagonal& d2, const Vector& x2,
                                  const Diagonal& d3, const Vector& x3, Vector& out) {
+  if (device::current()) {
+    const Diagonal* ds[] = {&d1, &d2, &d3};
+    const Real none[] = {0, 0, 0};
+    const Vector* xs[] = {&x1, &x2, &x3};
+    return device::linear_combination(nullptr, ds, none, xs, out);
+  }
   out.resize(x1.size());
   const Index r = detail::common_run({&d1, &d2, &d3});
   const Vector &v1 = d1.values(), &v2 = d2.values(), &v3 = d3.values();
@@ -186,6 +242,7 @@ inline void diagonal_combination(const Diagonal& d1, const Vector& x1, const Dia
 /// the terms accumulated in the order given, as above (out may alias start or any x_j).
 inline void diagonal_linear_combination(const Vector* start, std::span<const Diagonal* const> d,
                                         std::span<const Vector* const> x, Vector& out) {
+  if (device::current()) return device::linear_combination(start, d, {}, x, out);
   const Index n = start ? start->size() : x.front()->size();
   out.resize(n);
   Index r = d.empty() ? 1 : d.front()->run();
@@ -229,18 +286,19 @@ inline void diagonal_linear_combination(const Vector* start, std::span<const Dia
 
 /// True when every entry of x is finite: one pass, no allocation (the check a run makes at
 /// every step, between the steps its observers record).
-inline bool all_finite(const Vector& x) { return x.allFinite(); }
+inline bool all_finite(const Vector& x) { return device::current() ? device::all_finite(x) : x.allFinite(); }
 
 /// Re <x, y> = Re sum conj(x_i) y_i: the inner product of the state as a real vector.
-using tsi::inner;
+inline Real inner(const Vector& x, const Vector& y) { return device::current() ? device::inner(x, y) : tsi::inner(x, y); }
 
-/// max_i |x_i| (types.hpp's, which also takes expressions).
-using tsi::max_norm;
+/// max_i |x_i|.
+inline Real max_norm(const Vector& x) { return device::current() ? device::max_norm(x) : tsi::max_norm(x); }
 
 /// The squares of max_i |next_i - x_i| and of max_i |next_i| into m[0] and m[1]: one pass over
 /// the doubles in two independent lanes, so the maxima stay in vector registers (std::max over
 /// complex norms in one chain ran at the latency of a compare: 30% of a charged-particle step).
 inline void increment_maxima(const Vector& next, const Vector& x, Real m[2]) {
+  if (device::current()) return device::increment_maxima(next, x, m);
   const Real* pa = reinterpret_cast<const Real*>(next.data());
   const Real* pb = reinterpret_cast<const Real*>(x.data());
   const Index n = 2 * next.size();

@@ -11,6 +11,7 @@
 #include <omp.h>
 #endif
 
+#include "tsi/device.hpp"
 #include "tsi/error.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/stop_request.hpp"
@@ -118,6 +119,7 @@ void TauGrid::bind_diagonal() {
 void TauGrid::nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, Real phase) {
   throw_if_stop_requested("evaluating the nonlinearity on the tau grid");  // seconds on a large grid
   ++*evaluations_;
+  if (device::current()) return device_nonlinear(y, mean_shift, out);
   if (needs_diagonal_) {
     evaluate_into(Eigen::Map<const Matrix>(y.data(), dim_, columns_), phase, diagonal_);
     if (mean_shift) diagonal_ += *mean_shift;
@@ -139,6 +141,15 @@ void TauGrid::nonlinear(const Vector& y, const Vector* mean_shift, Vector& out, 
     field = field_.data();
   }
   fft_->transform(field, out.data(), 0, 1.0 / n_tau_);  // the 1/n of the transform
+}
+
+void TauGrid::device_nonlinear(const Vector& y, const Vector* mean_shift, Vector& out) {
+  if (real_layout_ || needs_diagonal_ || mean_shift)
+    throw Error("--device cuda: the device's tau grid takes a complex model whose field does not read U on the "
+                "diagonal (reformulation.real_layout: false for a real one), and no shifted evaluations");
+  if (!device_) device_ = make_device_tau_grid(*model_, taus_, dim_, n_tau_);
+  const Complex* in = device::read(y);
+  device_->nonlinear(in, device::write(out, size()));
 }
 
 void TauGrid::nonlinear_threaded(const Vector& y, const Vector* mean_shift, Vector& out) {

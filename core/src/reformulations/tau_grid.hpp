@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "tsi/context.hpp"
+#include "device_tau_grid.hpp"
 #include "tsi/fft.hpp"
 #include "tsi/model.hpp"
 #include "tsi/real_fft.hpp"
@@ -95,6 +96,8 @@ class TauGrid {
   /// f_tau on the real tau grid (real layout), in grid_values_ where the binding evaluates in
   /// place, else into field_values_, on columns [c0, c0 + cn) with binding `field`.
   void evaluate_real_grid(TauGridField& field, Index c0, Index cn);
+  /// nonlinear on the device (a tsi::device::Scope open on this thread).
+  void device_nonlinear(const Vector& y, const Vector* mean_shift, Vector& out);
   /// nonlinear in the real layout.
   void nonlinear_real(const Vector& y, const Vector* mean_shift, Vector& out);
   /// nonlinear in the real layout by blocks of rows (row_blocks_): a block's coefficients to
@@ -149,6 +152,7 @@ class TauGrid {
   // Real layout, a field independent across groups of rows: transforms and field by blocks of
   // rows, each in a small buffer (none of the grid's size).
   std::unique_ptr<RealFftRows> row_blocks_;
+  std::unique_ptr<DeviceTauGrid> device_;  // made on the first evaluation on the device
 };
 
 }  // namespace tsi

@@ -41,6 +41,10 @@
 #include "tsi/phase.hpp"
 #include "tsi/plugin.hpp"
 #include "tsi/spectral_grid.hpp"
+#if defined(TSI_WITH_CUDA)
+#include "nls_device.hpp"
+#include "tsi/device_kernels.hpp"
+#endif
 
 namespace {
 
@@ -140,7 +144,11 @@ class Nls final : public tsi::Model,
                   public tsi::FusedTauGrid,
                   public tsi::ExactNonlinearFlow,
                   public tsi::PhysicalVariables,
-                  public tsi::ExactSolution {
+                  public tsi::ExactSolution
+#if defined(TSI_WITH_CUDA)
+    , public tsi::DeviceKernels
+#endif
+{
  public:
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
   // dealias: the 2/3 rule on the field (and on u0), see the header.
@@ -231,6 +239,35 @@ class Nls final : public tsi::Model,
     Phases phases_;
     tsi::GridTransforms batch_;
   };
+
+#if defined(TSI_WITH_CUDA)
+  // f_tau on the device (nls_device.cu): the host's phase tables and folded indices uploaded,
+  // so that the device's phases are the host's to the bit.
+  class DeviceField final : public tsi::DeviceTauGridField {
+   public:
+    explicit DeviceField(std::unique_ptr<nls_device::Kernels> kernels) : kernels_(std::move(kernels)) {}
+    void evaluate(Complex* grid, Real scale) override { kernels_->evaluate(grid, scale); }
+    bool evaluate_coefficients(const Complex* y, Complex* out, Real scale) override {
+      return kernels_->evaluate_coefficients(y, out, scale);
+    }
+
+   private:
+    std::unique_ptr<nls_device::Kernels> kernels_;
+  };
+  std::unique_ptr<tsi::DeviceTauGridField> bind_device_tau_grid(const tsi::RealVector& taus) const override {
+    nls_device::Setup setup;
+    setup.shape = grid_.shape();
+    for (int i = 0; i < grid_.dims(); ++i) {
+      setup.folded.push_back(grid_.folded(i));
+      const tsi::Matrix table = phase_table(taus, grid_.shape()[static_cast<std::size_t>(i)]);
+      setup.phases.emplace_back(table.data(), table.data() + table.size());
+    }
+    if (dealias_.size()) setup.dealias_mask.assign(dealias_.data(), dealias_.data() + dealias_.size());
+    setup.field_scale = 1.0 / (volume_ * point_count());
+    setup.n_tau = static_cast<int>(taus.size());
+    return std::make_unique<DeviceField>(nls_device::make_kernels(setup));
+  }
+#endif
 
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
     return std::make_unique<GridField>(*this, taus);
