@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # The device backend's check on a machine with a CUDA GPU (docs/how-to/gpu.md): the CUDA tests
-# (the algebra and the two-scale NLS steps of SE1 and eab against the CPU), then the step
-# benchmark (2-D NLS 1024 x 1024, n_tau 32: a step against the cuFFT bound and the CPU, the
-# device's memory). Prints a short table last; logs and JSON go to $OUT (or ./device-check).
+# (the algebra, and the two-scale NLS and particle-in-cell steps of SE1 and eab against the
+# CPU), then the step benchmark (2-D NLS 1024 x 1024, n_tau 32: a step against the cuFFT bound
+# and the CPU, the device's memory; the particle-in-cell plasma of 2^20 particles). Prints a short table last; logs and JSON go to $OUT (or ./device-check).
 #
 #   scripts/device-check.sh            uses build-cuda/ (built here first where it is missing:
 #                                      cmake -DTSI_WITH_CUDA=ON, needs nvcc and the project's deps)
 #   TSI_DEVICE_LIBS=DIR scripts/...    shared libraries to put first on the library path (a
 #                                      build tree carried from another machine with its deps)
 #   TSI_BENCH_N=512 scripts/...        a smaller grid (default 1024)
+#   TSI_BENCH_PARTICLES=N scripts/...  the particle-in-cell benchmark's particles (default 2^20; 0: none)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -33,11 +34,11 @@ status=0
 echo "== tests"
 (cd "$out" && "$root/$build/bin/tsi_cuda_tests" --success=false 2>&1) | tee "$out/tests.log" || status=1
 if command -v compute-sanitizer > /dev/null; then
-  echo "== compute-sanitizer memcheck (the algebra and the 2-D steps)"
+  echo "== compute-sanitizer memcheck (the algebra, the NLS and particle-in-cell steps)"
   (cd "$out" && compute-sanitizer --tool memcheck --error-exitcode 9 "$root/$build/bin/tsi_cuda_tests" \
-     --test-case='device algebra*' 2>&1 | tail -5) | tee "$out/memcheck.log" || status=1
+     --test-case='device algebra*,device NLS*,device particle*' 2>&1 | tail -5) | tee "$out/memcheck.log" || status=1
 fi
 echo "== step benchmark"
 "$root/$build/bin/tsi_cuda_bench" --n "${TSI_BENCH_N:-1024}" --n-tau 32 --steps 5 --cpu-steps 1 \
-  --json "$out/bench.json" 2>&1 | tee "$out/bench.log" || status=1
+  --pic-particles "${TSI_BENCH_PARTICLES:-1048576}" --json "$out/bench.json" 2>&1 | tee "$out/bench.log" || status=1
 exit $status

@@ -559,7 +559,15 @@ void check_device_run(const Json& config, const Assembly& assembly, const RunSet
                                                         "device runs the two-scale problem)", reformulation));
   if (!dynamic_cast<const DeviceKernels*>(assembly.model.get()))
     throw ConfigError("model.name", fmt::format("got \"{}\" with --device cuda; expected a model with device kernels: "
-                                                "nls", assembly.model_entry->info.name));
+                                                "nls, vlasov-poisson-2d", assembly.model_entry->info.name));
+  const Json& mconf = config["model"];
+  if (mconf.contains("tau_field") && mconf["tau_field"] != "per-tau")
+    throw ConfigError("model.tau_field", fmt::format("got {} with --device cuda; expected \"per-tau\"",
+                                                     mconf["tau_field"].dump()));
+  // The device's tau grid is the complex layout's; a real model keeps it only when asked.
+  if (!assembly.model->is_complex() && config["reformulation"].value("real_layout", true))
+    throw ConfigError("reformulation.real_layout", "got true (the default for a real model) with --device cuda; "
+                                                   "expected false: the device's tau grid is the complex layout");
   // The schemes whose steps were checked against the CPU on a device (docs/how-to/gpu.md): a
   // scheme that read a state's entries on the host would read a stale copy there.
   const std::string& scheme = assembly.scheme_entry->info.name;

@@ -2,6 +2,7 @@
 // (TSI_WITH_CUDA; scripts/device-check.sh runs it).
 //
 //   tsi_cuda_bench [--n 1024] [--n-tau 32] [--steps 5] [--cpu-steps 1] [--threads T] [--json FILE]
+//                  [--pic-particles N]
 //   (--steps 0: the CPU's steps only, on a machine without a GPU)
 //
 // For SE1 and eab on the 2-D NLS of n x n points (eps = 0.1, the paper's data): the median
@@ -9,7 +10,8 @@
 // (tau inverse, spatial inverse, spatial forward, tau forward) timed alone with the same plans:
 // the cuFFT bound of a step is that times the step's evaluations of N. Then the same steps on
 // the CPU (T threads), the relative difference of the states after two steps, and the device
-// memory the run held.
+// memory the run held. With --pic-particles N, the same for the particle-in-cell plasma of N
+// particles (vlasov-poisson-2d, per-tau field, 64 x 64 grid, n_tau 16).
 #include <cuda_runtime.h>
 #include <cufft.h>
 #include <fmt/format.h>
@@ -107,11 +109,22 @@ struct Measured {
   long sweeps = 0;
 };
 
-Measured measure(Registry& registry, const std::string& scheme, int n, int n_tau, int steps, int cpu_steps, int threads) {
-  Json s = {{"name", scheme}};
-  Json config = {{"model", {{"name", "nls"}, {"eps", 0.1}, {"dims", 2}, {"n_x", n}, {"n_y", n}}},
-                 {"reformulation", {{"name", "two-scale"}, {"n_tau", n_tau}, {"initial_data_order", 2}}},
-                 {"scheme", s}};
+Json nls_config(const std::string& scheme, int n, int n_tau) {
+  return {{"model", {{"name", "nls"}, {"eps", 0.1}, {"dims", 2}, {"n_x", n}, {"n_y", n}}},
+          {"reformulation", {{"name", "two-scale"}, {"n_tau", n_tau}, {"initial_data_order", 2}}},
+          {"scheme", {{"name", scheme}}}};
+}
+
+// The particle-in-cell plasma of the UA-PIC peer's data (SPEC.md section 7) at 2^20 particles
+// on a 64 x 64 grid, each tau column with its own field (per-tau), the complex layout.
+Json pic_config(const std::string& scheme, long particles, int n_tau) {
+  return {{"model", {{"name", "vlasov-poisson-2d"}, {"eps", 0.1}, {"particles", particles}, {"distribution", "peer"},
+                     {"alpha", 0.5}, {"n_x", 64}, {"n_y", 64}, {"shape", "m6"}}},
+          {"reformulation", {{"name", "two-scale"}, {"n_tau", n_tau}, {"initial_data_order", 2}, {"real_layout", false}}},
+          {"scheme", {{"name", scheme}}}};
+}
+
+Measured measure(Registry& registry, const Json& config, int steps, int cpu_steps, int threads) {
   AssemblyOptions options;
   options.context = Context::with_threads(threads, threads);
   Assembly a = assemble_config(config, registry, options);
@@ -186,6 +199,7 @@ Measured measure(Registry& registry, const std::string& scheme, int n, int n_tau
 
 int main(int argc, char** argv) {
   int n = 1024, n_tau = 32, steps = 5, cpu_steps = 1;
+  long pic_particles = 0;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::string json_file;
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -196,6 +210,7 @@ int main(int argc, char** argv) {
     else if (flag == "--cpu-steps") cpu_steps = std::stoi(value);
     else if (flag == "--threads") threads = std::stoi(value);
     else if (flag == "--json") json_file = value;
+    else if (flag == "--pic-particles") pic_particles = std::stol(value);
     else {
       std::fprintf(stderr, "tsi_cuda_bench: unknown flag %s\n", flag.c_str());
       return 2;
@@ -219,7 +234,7 @@ int main(int argc, char** argv) {
     fmt::print("{:<6} {:>10} {:>8} {:>12} {:>8} {:>12} {:>10} {:>12} {:>10}\n", "scheme", "step ms", "N/step",
                "bound ms", "x bound", "CPU step s", "CPU/GPU", "rel. diff", "GPU GiB");
     for (const std::string scheme : {"se1", "eab"}) {
-      const Measured m = measure(registry, scheme, n, n_tau, steps, cpu_steps, threads);
+      const Measured m = measure(registry, nls_config(scheme, n, n_tau), steps, cpu_steps, threads);
       const double step_bound = bound * m.evaluations_per_step;
       fmt::print("{:<6} {:>10.3f} {:>8.2f} {:>12.3f} {:>8.2f} {:>12.3f} {:>10.1f} {:>12.2e} {:>10.2f}\n", scheme,
                  m.step * 1e3, m.evaluations_per_step, step_bound * 1e3, step_bound > 0 ? m.step / step_bound : 0.0,
@@ -233,6 +248,25 @@ int main(int argc, char** argv) {
                                 {"three_vector_pass_seconds", m.pass},
                                 {"device_bytes", m.device_bytes},
                                 {"state_bytes", m.state_bytes}};
+    }
+    if (pic_particles > 0) {
+      fmt::print("particle-in-cell, {} particles, 64 x 64 grid, M6, n_tau = 16, per-tau field:\n", pic_particles);
+      fmt::print("{:<6} {:>10} {:>8} {:>12} {:>10} {:>12} {:>10}\n", "scheme", "step ms", "N/step", "CPU step s",
+                 "CPU/GPU", "rel. diff", "GPU GiB");
+      for (const std::string scheme : {"se1", "eab"}) {
+        const Measured m = measure(registry, pic_config(scheme, pic_particles, 16), steps, cpu_steps, threads);
+        fmt::print("{:<6} {:>10.3f} {:>8.2f} {:>12.3f} {:>10.1f} {:>12.2e} {:>10.2f}\n", scheme, m.step * 1e3,
+                   m.evaluations_per_step, m.cpu_step, m.cpu_step > 0 && m.step > 0 ? m.cpu_step / m.step : 0.0,
+                   m.difference, m.device_bytes / 1073741824.0);
+        out["pic"][scheme] = {{"particles", pic_particles},
+                              {"step_seconds", m.step},
+                              {"evaluations_per_step", m.evaluations_per_step},
+                              {"cpu_step_seconds", m.cpu_step},
+                              {"relative_difference_after_two_steps", m.difference},
+                              {"nonlinear_seconds", m.nonlinear},
+                              {"device_bytes", m.device_bytes},
+                              {"state_bytes", m.state_bytes}};
+      }
     }
     for (const auto& [name, r] : out["schemes"].items())
       fmt::print("{}: one evaluation of N {:.3f} ms, one pass over three vectors {:.3f} ms ({:.2f} TB/s)\n", name,

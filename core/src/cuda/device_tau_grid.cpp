@@ -44,7 +44,7 @@ std::unique_ptr<DeviceTauGrid> make_device_tau_grid(const Model& model, const Re
   const auto* kernels = dynamic_cast<const DeviceKernels*>(&model);
   if (!kernels)
     throw Error("--device cuda: the model has no device kernels (tsi::DeviceKernels); the models that run on the "
-                "device: nls");
+                "device: nls, vlasov-poisson-2d");
   return std::make_unique<CudaTauGrid>(kernels->bind_device_tau_grid(taus), dim, n_tau);
 }
 

@@ -20,6 +20,11 @@
 #include "tsi/model.hpp"
 #include "tsi/params.hpp"
 #include "tsi/plugin.hpp"
+#if defined(TSI_WITH_CUDA)
+#include "pic_device.hpp"
+#include "tsi/device_kernels.hpp"
+#include "tsi/spectral_grid.hpp"
+#endif
 
 namespace {
 
@@ -59,7 +64,13 @@ void filtered_column(const Real* e, Index particles, const Real* u, ParticleLayo
 // t, frozen along tau (the UA-PIC codes': one deposition and solve per evaluation).
 enum class TauField { per_tau, diagonal };
 
-class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, public tsi::PhysicalVariables {
+class VlasovPoisson2d final : public tsi::Model,
+                              public tsi::FusedTauGrid,
+                              public tsi::PhysicalVariables
+#if defined(TSI_WITH_CUDA)
+    , public tsi::DeviceKernels
+#endif
+{
  public:
   VlasovPoisson2d(Real eps, Geometry geometry, TauField tau_field, tsi::RealVector particles,
                   const tsi::Collective* collective)
@@ -189,6 +200,47 @@ class VlasovPoisson2d final : public tsi::Model, public tsi::FusedTauGrid, publi
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
     return std::make_unique<GridField>(g_, tau_field_, taus, collective_);
   }
+
+#if defined(TSI_WITH_CUDA)
+  // f_tau on the device (pic_device.cu): each column's deposition, solve and interpolation, with
+  // the host Field's wave numbers and weights.
+  class DeviceField final : public tsi::DeviceTauGridField {
+   public:
+    explicit DeviceField(std::unique_ptr<pic_device::Kernels> kernels) : kernels_(std::move(kernels)) {}
+    void evaluate(tsi::Complex* grid, Real scale) override { kernels_->evaluate(grid, scale); }
+
+   private:
+    std::unique_ptr<pic_device::Kernels> kernels_;
+  };
+  std::unique_ptr<tsi::DeviceTauGridField> bind_device_tau_grid(const tsi::RealVector& taus) const override {
+    if (tau_field_ != TauField::per_tau)
+      throw tsi::ConfigError("model.tau_field", "got \"diagonal\" with --device cuda; expected \"per-tau\"");
+    if (collective_) throw tsi::Error("--device cuda: a split run's particles stay on the CPU");
+    pic_device::Setup s;
+    s.n_x = g_.n_x;
+    s.n_y = g_.n_y;
+    s.width = g_.shape == tsi::pic::Shape::cic ? 2 : 6;
+    s.offset = g_.shape == tsi::pic::Shape::cic ? 0 : 2;
+    s.particles = g_.particles;
+    s.inverse_dx = 1.0 / g_.dx();
+    s.inverse_dy = 1.0 / g_.dy();
+    s.weight = g_.weight();
+    s.inverse_cell = 1.0 / (g_.dx() * g_.dy());
+    const tsi::SpectralGrid grid({g_.n_y, g_.n_x});  // as Field's: (n_y, n_x), x halved
+    const Index half_x = g_.n_x / 2 + 1, half = half_x * g_.n_y;
+    for (Index p = 0; p < half; ++p) {
+      const int jy = static_cast<int>(p / half_x), ix = static_cast<int>(p % half_x);
+      const Real k1 = g_.k_x * ix, k2 = g_.k_y * grid.wave_number(0, jy), k_squared = k1 * k1 + k2 * k2;
+      s.k1.push_back(k1);
+      s.k2.push_back(k2);
+      s.inverse_k2.push_back(k_squared > 0.0 ? 1.0 / k_squared : 0.0);
+    }
+    const tsi::RealVector c = taus.array().cos(), sn = taus.array().sin();  // GridField's
+    s.cos_tau.assign(c.data(), c.data() + c.size());
+    s.sin_tau.assign(sn.data(), sn.data() + sn.size());
+    return std::make_unique<DeviceField>(pic_device::make_kernels(s));
+  }
+#endif
   // Split over processes, the field's reductions must come in one order: one thread calls them.
   bool independent_tau_grid_bindings() const override { return !collective_; }
   /// The filtered problem's f_tau, phases per call: through the model's one field (a binding
