@@ -150,10 +150,12 @@ TEST_CASE("device NLS: SE1 and eab steps equal the CPU's to 1e-12 relative in 1,
     double eps;
     bool dealias;
   };
-  // n_tau a power of two up to 32: the NLS kernels' fused tau transforms; 12 and 64: the core's
-  // cuFFT tau transforms around the kernels' field
+  // n_tau a power of two up to 32: the NLS kernels' fused tau transforms (16 and 32: a point's
+  // values over two lanes; 8: in one); 12 and 64: the core's cuFFT tau transforms around the
+  // kernels' field
   for (const Case c : {Case{1, 64, 32, 0.1, false}, Case{2, 64, 32, 0.1, false}, Case{2, 32, 16, 0.01, true},
-                       Case{3, 16, 16, 0.1, false}, Case{1, 64, 12, 0.1, false}, Case{2, 32, 64, 0.1, true}})
+                       Case{3, 16, 16, 0.1, false}, Case{2, 32, 8, 0.1, false}, Case{1, 64, 12, 0.1, false},
+                       Case{2, 32, 64, 0.1, true}})
     for (const std::string scheme : {"se1", "eab"}) {
       CAPTURE(scheme);
       CAPTURE(c.dims);

@@ -95,23 +95,34 @@ __host__ __device__ constexpr int bit_reversed(int i, int n) {
 // backward, -1: its forward), unnormalised, in natural order: radix-2 stages in place.
 // One radix-2 stage of butterflies of length `len` (then the next, by recursion: every index a
 // compile-time constant, so that the values stay in registers).
-template <int N, int sign, int len>
-__device__ inline void butterflies(double2 (&a)[N], const Twiddles<N>& tw) {
-  if constexpr (len <= N) {
+template <int M, int sign, int len, int stride>
+__device__ inline void butterflies(double2 (&a)[M], const double2* w) {
+  if constexpr (len <= M) {
 #pragma unroll
-    for (int i = 0; i < N; i += len) {
+    for (int i = 0; i < M; i += len) {
 #pragma unroll
       for (int k = 0; k < len / 2; ++k) {
-        double2 w = tw.w[k * (N / len)];
-        if (sign < 0) w.y = -w.y;
+        double2 t_w = w[k * (M / len) * stride];
+        if (sign < 0) t_w.y = -t_w.y;
         const double2 u = a[i + k], v = a[i + k + len / 2];
-        const double2 t = {__fma_rn(v.x, w.x, -v.y * w.y), __fma_rn(v.x, w.y, v.y * w.x)};
+        const double2 t = {__fma_rn(v.x, t_w.x, -v.y * t_w.y), __fma_rn(v.x, t_w.y, v.y * t_w.x)};
         a[i + k] = {u.x + t.x, u.y + t.y};
         a[i + k + len / 2] = {u.x - t.x, u.y - t.y};
       }
     }
-    butterflies<N, sign, 2 * len>(a, tw);
+    butterflies<M, sign, 2 * len, stride>(a, w);
   }
+}
+
+// a * w (sign +1) or a * conj(w) (sign -1), in fused multiply-adds.
+template <int sign>
+__device__ inline double2 rotate(double2 a, double2 w) {
+  if (sign < 0) w.y = -w.y;
+  return {__fma_rn(a.x, w.x, -a.y * w.y), __fma_rn(a.x, w.y, a.y * w.x)};
+}
+
+__device__ inline double2 exchange(double2 v) {
+  return {__shfl_xor_sync(0xffffffffu, v.x, 1), __shfl_xor_sync(0xffffffffu, v.y, 1)};
 }
 
 // Coefficients y (dim x N) -> out(p, j) = e^{-i |m_p|^2 tau_j} sum_k y(p, k) e^{i k tau_j}.
@@ -121,7 +132,7 @@ __global__ void tau_inverse_phased(Geometry g, Twiddles<N> tw, const double2* y,
     double2 a[N];  // in bit-reversed order, for the radix-2 stages
 #pragma unroll
     for (int k = 0; k < N; ++k) a[bit_reversed(k, N)] = y[p + static_cast<size_t>(g.points) * k];
-    butterflies<N, 1, 2>(a, tw);
+    butterflies<N, 1, 2, 1>(a, tw.w);
     const PointPhase e(g, p);
 #pragma unroll
     for (int j = 0; j < N; ++j) out[p + static_cast<size_t>(g.points) * j] = times(a[j], e(static_cast<unsigned>(j)));
@@ -143,7 +154,7 @@ __global__ void phased_tau_forward(Geometry g, Twiddles<N> tw, double2* w, const
       v = times_conj(v, e(static_cast<unsigned>(j)));
       if (mask) v = {v.x * m, v.y * m};
     }
-    butterflies<N, -1, 2>(a, tw);
+    butterflies<N, -1, 2, 1>(a, tw.w);
 #pragma unroll
     for (int k = 0; k < N; ++k) w[p + static_cast<size_t>(g.points) * k] = a[k];
   }
@@ -175,6 +186,83 @@ __global__ void phases_out(Geometry g, double2* grid, const double* mask) {
     double2 v = times_conj(column[p], phase(g, p, j));
     if (mask) v = {v.x * mask[p], v.y * mask[p]};
     column[p] = v;
+  }
+}
+
+// The same two passes with each point's N values split over two neighbouring lanes (N >= 16):
+// half the registers per thread (the one-lane kernels need 166 and 255 at N = 32, and then only
+// 12 to 18% of the warps a multiprocessor holds are active). One radix-2 stage goes between the
+// lanes by shuffles, the rest are N/2-point transforms in registers. Lane h of a pair:
+//   inverse (decimation in time): the DFT of the inputs of parity h; lane 1 turns its by W^m;
+//     then lane 0 writes X[m] = E[m] + W^m O[m], lane 1 X[m + N/2] = E[m] - W^m O[m];
+//   forward (decimation in frequency): lane h holds values j + h N/2; then lane 0 transforms
+//     v[j] + v[j + N/2] into the even outputs, lane 1 (v[j] - v[j + N/2]) W^-j into the odd ones.
+// Every read of a point comes before the shuffles, so out may be y.
+template <int N>
+__global__ void tau_inverse_phased_pairs(Geometry g, Twiddles<N> tw, const double2* y, double2* out) {
+  constexpr int M = N / 2;
+  const unsigned h = threadIdx.x & 1u;
+  const unsigned first = (blockIdx.x * blockDim.x + threadIdx.x) >> 1, stride = (gridDim.x * blockDim.x) >> 1;
+  const unsigned rounds = (g.points + stride - 1) / stride;  // the same in every lane: the shuffles need them all
+  for (unsigned r = 0; r < rounds; ++r) {
+    const unsigned p = first + r * stride;
+    const bool active = p < g.points;
+    double2 a[M];  // bit-reversed, for the radix-2 stages
+#pragma unroll
+    for (int m = 0; m < M; ++m)
+      a[bit_reversed(m, M)] = active ? y[p + static_cast<size_t>(g.points) * (2 * m + h)] : double2{0.0, 0.0};
+    butterflies<M, 1, 2, 2>(a, tw.w);
+#pragma unroll
+    for (int m = 0; m < M; ++m) {
+      if (h) a[m] = rotate<1>(a[m], tw.w[m]);
+      const double2 other = exchange(a[m]);
+      a[m] = h ? double2{other.x - a[m].x, other.y - a[m].y} : double2{a[m].x + other.x, a[m].y + other.y};
+    }
+    if (!active) continue;
+    const PointPhase e(g, p);
+#pragma unroll
+    for (int m = 0; m < M; ++m) {
+      const unsigned j = static_cast<unsigned>(m) + h * M;
+      out[p + static_cast<size_t>(g.points) * j] = times(a[m], e(j));
+    }
+  }
+}
+
+template <int N>
+__global__ void phased_tau_forward_pairs(Geometry g, Twiddles<N> tw, double2* w, const double* mask) {
+  constexpr int M = N / 2;
+  const unsigned h = threadIdx.x & 1u;
+  const unsigned first = (blockIdx.x * blockDim.x + threadIdx.x) >> 1, stride = (gridDim.x * blockDim.x) >> 1;
+  const unsigned rounds = (g.points + stride - 1) / stride;
+  for (unsigned r = 0; r < rounds; ++r) {
+    const unsigned p = first + r * stride;
+    const bool active = p < g.points;
+    double2 a[M];
+    if (active) {
+      const PointPhase e(g, p);
+      const double m = mask ? mask[p] : 1.0;
+#pragma unroll
+      for (int j = 0; j < M; ++j) {
+        const unsigned row = static_cast<unsigned>(j) + h * M;
+        double2 v = times_conj(w[p + static_cast<size_t>(g.points) * row], e(row));
+        if (mask) v = {v.x * m, v.y * m};
+        a[j] = v;
+      }
+    } else {
+#pragma unroll
+      for (int j = 0; j < M; ++j) a[j] = {0.0, 0.0};
+    }
+    double2 b[M];  // bit-reversed
+#pragma unroll
+    for (int j = 0; j < M; ++j) {
+      const double2 other = exchange(a[j]);
+      b[bit_reversed(j, M)] = h ? rotate<-1>(double2{other.x - a[j].x, other.y - a[j].y}, tw.w[j])
+                                : double2{a[j].x + other.x, a[j].y + other.y};
+    }
+    butterflies<M, -1, 2, 2>(b, tw.w);
+    if (!active) continue;
+#pragma unroll
+    for (int k = 0; k < M; ++k) w[p + static_cast<size_t>(g.points) * (2 * k + h)] = b[k];
   }
 }
 
@@ -256,15 +344,24 @@ class CudaKernels final : public Kernels {
     auto* o = reinterpret_cast<double2*>(out);
     auto* c = reinterpret_cast<cufftDoubleComplex*>(out);
     constexpr int fused_threads = 128;  // a thread holds N values: more blocks of fewer threads fill the SMs
-    const unsigned b = static_cast<unsigned>(std::min<size_t>((g_.points + fused_threads - 1) / fused_threads, 65536u * 16));
-    tau_inverse_phased<N><<<b, fused_threads, 0, cudaStreamPerThread>>>(g_, tw, reinterpret_cast<const double2*>(y), o);
+    // from N = 16 two lanes share a point (twice the threads)
+    constexpr bool pairs = N >= 16;
+    const unsigned b = static_cast<unsigned>(
+        std::min<size_t>(((pairs ? 2 : 1) * static_cast<size_t>(g_.points) + fused_threads - 1) / fused_threads, 65536u * 16));
+    if constexpr (pairs)
+      tau_inverse_phased_pairs<N><<<b, fused_threads, 0, cudaStreamPerThread>>>(g_, tw, reinterpret_cast<const double2*>(y), o);
+    else
+      tau_inverse_phased<N><<<b, fused_threads, 0, cudaStreamPerThread>>>(g_, tw, reinterpret_cast<const double2*>(y), o);
     check(cudaGetLastError(), "tau_inverse_phased");
     check(cufftExecZ2Z(plan_, c, c, CUFFT_INVERSE), "cufftExecZ2Z (inverse)");
     const size_t n = static_cast<size_t>(g_.points) * static_cast<size_t>(n_tau_);
     cubic<<<blocks(n), threads, 0, cudaStreamPerThread>>>(o, n, field_scale_ * scale);
     check(cudaGetLastError(), "cubic");
     check(cufftExecZ2Z(plan_, c, c, CUFFT_FORWARD), "cufftExecZ2Z (forward)");
-    phased_tau_forward<N><<<b, fused_threads, 0, cudaStreamPerThread>>>(g_, tw, o, mask_);
+    if constexpr (pairs)
+      phased_tau_forward_pairs<N><<<b, fused_threads, 0, cudaStreamPerThread>>>(g_, tw, o, mask_);
+    else
+      phased_tau_forward<N><<<b, fused_threads, 0, cudaStreamPerThread>>>(g_, tw, o, mask_);
     check(cudaGetLastError(), "phased_tau_forward");
     return true;
   }
