@@ -366,6 +366,14 @@ Assembly assemble(const ResolvedSelection& resolved, const Registry& registry, c
                                   a.model->has_exact_nonlinear_flow()
                                       ? " (only \"direct\" in model variables does)"
                                       : " (the model has no exact nonlinear flow)"));
+  if (traits.needs_second_order_form && !a.reformulation->second_order())
+    throw ConfigError("scheme.name",
+                      fmt::format("scheme \"{}\" needs the second-order form x'' = -Omega^2 x + g(x), which {} does "
+                                  "not provide{}",
+                                  a.scheme_entry->info.name, pair,
+                                  a.model->has_second_order_form()
+                                      ? " (only \"direct\" does)"
+                                      : " (the model does not declare it; models that do: fput)"));
   if (binds) a.bind(options.h);
   return a;
 }

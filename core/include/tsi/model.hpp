@@ -98,12 +98,15 @@ class TSI_API Model {
   virtual const PhysicalVariables* physical_variables() const { return nullptr; }
   /// The exact solution of the whole equation.
   virtual const ExactSolution* exact_solution() const { return nullptr; }
+  /// The second-order form x'' = -Omega^2 x + g(x) (trigonometric integrators).
+  virtual const SecondOrderForm* second_order_form() const { return nullptr; }
 
   // ---- What the rest of tsi uses, built on the above (not virtual) -----------------------
 
   bool has_time_dependent_field() const { return time_dependent_field() != nullptr; }
   bool has_hamiltonian_structure() const { return hamiltonian() != nullptr; }
   bool has_exact_nonlinear_flow() const { return exact_nonlinear_flow() != nullptr; }
+  bool has_second_order_form() const { return second_order_form() != nullptr; }
   bool has_linear_remainder() const { return linear_remainder().size() > 0; }
 
   /// e^{A tau} applied to one state.

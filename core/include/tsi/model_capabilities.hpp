@@ -126,6 +126,26 @@ class TSI_API ExactNonlinearFlow {
   virtual void nonlinear_flow(Real t, Vector& u) const = 0;
 };
 
+/// The second-order form x'' = -Omega^2 x + g(x) of a model whose state is positions x and
+/// velocities x' (Hamiltonian with a quadratic kinetic energy and a stiff quadratic potential
+/// diagonal in x): what trigonometric (Gautschi-type) integrators take (SPEC.md section 8).
+/// Omega is diagonal with entries >= 0 and holds the model's 1/eps (FPUT's stiff springs: omega
+/// = 1/eps on the elongations, 0 on the centres).
+class TSI_API SecondOrderForm {
+ public:
+  virtual ~SecondOrderForm() = default;
+  /// n, the number of positions.
+  virtual Index positions() const = 0;
+  /// Omega's diagonal (n entries, >= 0).
+  virtual RealVector frequencies() const = 0;
+  /// The positions and velocities (n each) of a model state u.
+  virtual void to_second_order(const Vector& u, RealVector& x, RealVector& v) const = 0;
+  /// The model state of positions x and velocities v.
+  virtual void from_second_order(const RealVector& x, const RealVector& v, Vector& u) const = 0;
+  /// g(x) (n entries).
+  virtual void force(const RealVector& x, RealVector& g) const = 0;
+};
+
 /// Physical variables different from the model's own (an initial value in a config, u_final,
 /// errors and their norm): without it they are the model's variables, errors in the Euclidean
 /// norm.

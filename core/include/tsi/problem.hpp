@@ -22,6 +22,22 @@ struct TSI_API ProblemLayout {
   bool stores_stage_bases() const { return size <= max_stored_base; }
 };
 
+/// A problem in the second-order form x'' = -Omega^2 x + g(x) (the direct problem of a model
+/// that declares tsi::SecondOrderForm): its state read as positions and velocities, and g.
+class TSI_API SecondOrderProblem {
+ public:
+  virtual ~SecondOrderProblem() = default;
+  virtual Index positions() const = 0;
+  /// Omega's diagonal (positions() entries, >= 0).
+  virtual const RealVector& frequencies() const = 0;
+  /// The positions and velocities of a state y of the problem.
+  virtual void split(const Vector& y, RealVector& x, RealVector& v) = 0;
+  /// The state y of positions x and velocities v.
+  virtual void join(const RealVector& x, const RealVector& v, Vector& y) = 0;
+  /// g(x); one evaluation of the problem's N (its work measure).
+  virtual void force(const RealVector& x, RealVector& g) = 0;
+};
+
 /// The problem a stepper integrates:  y' = L y + N(t, y).
 /// L is diagonal in the problem's coordinates when linear_multipliers() has one entry per
 /// unknown (two-scale: -i k / eps per tau-Fourier mode; filtered: all zero); it is empty
@@ -68,6 +84,10 @@ class TSI_API Problem {
   virtual void linear_flow(Real h, Vector& y);
   /// y <- the exact flow of y' = N(t, y) from t to t + h. The default throws tsi::Error.
   virtual void nonlinear_flow(Real t, Real h, Vector& y);
+
+  /// The problem in the second-order form, or null (the default: the model declares none, or
+  /// the reformulation is not the direct one).
+  virtual SecondOrderProblem* second_order() { return nullptr; }
 
   /// Evaluations of N (or of rhs) since construction: the work measure of a run.
   long evaluations() const { return evaluations_; }

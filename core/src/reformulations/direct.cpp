@@ -32,6 +32,42 @@ void require_linear_to_physical(const Model& model) {
 
 }  // namespace
 
+// The model's second-order form through the packing: the state unpacked into the model's d
+// values (a buffer of the run), then the model's own map; each force one evaluation of N.
+class Direct::SecondOrder final : public SecondOrderProblem {
+ public:
+  SecondOrder(const Model& model, const SecondOrderForm& form, const RealPacking& packing, long& evaluations)
+      : form_(form),
+        packing_(packing),
+        evaluations_(evaluations),
+        frequencies_(form.frequencies()),
+        values_(model.dim()) {}
+  Index positions() const override { return form_.positions(); }
+  const RealVector& frequencies() const override { return frequencies_; }
+  void split(const Vector& y, RealVector& x, RealVector& v) override {
+    if (!packing_.on()) return form_.to_second_order(y, x, v);
+    packing_.unpack(y.data(), values_.data());
+    form_.to_second_order(values_, x, v);
+  }
+  void join(const RealVector& x, const RealVector& v, Vector& y) override {
+    if (!packing_.on()) return form_.from_second_order(x, v, y);
+    form_.from_second_order(x, v, values_);
+    y.resize(packing_.size());
+    packing_.pack(values_.data(), y.data());
+  }
+  void force(const RealVector& x, RealVector& g) override {
+    ++evaluations_;
+    form_.force(x, g);
+  }
+
+ private:
+  const SecondOrderForm& form_;
+  const RealPacking& packing_;
+  long& evaluations_;
+  RealVector frequencies_;
+  Vector values_;
+};
+
 Direct::Direct(std::shared_ptr<const Model> model, Variables variables, bool real_layout)
     : Reformulation(std::move(model)),
       physical_(variables == Variables::physical),
@@ -56,6 +92,8 @@ Direct::Direct(std::shared_ptr<const Model> model, Variables variables, bool rea
     x_.setZero(size_);
     result_.setZero(size_);
   }
+  if (const SecondOrderForm* form = model_->second_order_form(); form && !physical_)
+    second_order_ = std::make_unique<SecondOrder>(*model_, *form, packing_, evaluations_);
 }
 
 const Vector& Direct::values_of(const Vector& y) {

@@ -1,4 +1,6 @@
 #pragma once
+#include <memory>
+
 #include "real_packing.hpp"
 #include "tsi/phase.hpp"
 #include "tsi/reformulation.hpp"
@@ -37,6 +39,9 @@ class Direct final : public Reformulation {
   /// One exact nonlinear flow counts as one evaluation of N (the work measure of splitting).
   void nonlinear_flow(Real t, Real h, Vector& y) override;
 
+  /// The model's second-order form on this state (model variables only), or null.
+  SecondOrderProblem* second_order() override { return second_order_.get(); }
+
   Vector prepare(const Vector& u0) override { return packing_.packed(physical_ ? model_->to_physical(u0) : u0); }
   Vector read_back(const Vector& y, Real /*t*/) override {
     const Vector x = packing_.unpacked(y);
@@ -62,6 +67,8 @@ class Direct final : public Reformulation {
   Vector remainder_;  // i omega per coordinate (empty without a remainder)
   RealPacking packing_;
   Vector x_, result_;  // the state and N as d values, where the packing is on
+  class SecondOrder;
+  std::unique_ptr<SecondOrderProblem> second_order_;  // where the model declares the form
 };
 
 }  // namespace tsi

@@ -43,12 +43,61 @@ using tsi::Vector;
 
 constexpr long max_stiff_springs = 1000;  // dim 4000: far beyond any chain the literature runs
 
-class Fput final : public tsi::Model, public tsi::HamiltonianStructure, public tsi::PhysicalVariables {
+class Fput final : public tsi::Model,
+                   public tsi::HamiltonianStructure,
+                   public tsi::PhysicalVariables,
+                   public tsi::SecondOrderForm {
  public:
   Fput(Real eps, Index m) : Model(eps), m_(m), root_eps_(std::sqrt(eps)) {}
 
   const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
   const tsi::PhysicalVariables* physical_variables() const override { return this; }
+  const tsi::SecondOrderForm* second_order_form() const override { return this; }
+
+  // x'' = -Omega^2 x - grad U(x) in SPEC's x = (x_1..x_2m): Omega = diag(0 (m), omega = 1/eps (m)).
+  Index positions() const override { return 2 * m_; }
+  tsi::RealVector frequencies() const override {
+    tsi::RealVector omega = tsi::RealVector::Zero(2 * m_);
+    omega.tail(m_).setConstant(1 / eps());
+    return omega;
+  }
+  void to_second_order(const Vector& u, tsi::RealVector& x, tsi::RealVector& v) const override {
+    x.resize(2 * m_);
+    v.resize(2 * m_);
+    for (Index i = 0; i < m_; ++i) {
+      x(i) = u(i).real();
+      x(m_ + i) = root_eps_ * u(m_ + i).real();
+      v(i) = u(2 * m_ + i).real();
+      v(m_ + i) = u(3 * m_ + i).real() / root_eps_;
+    }
+  }
+  void from_second_order(const tsi::RealVector& x, const tsi::RealVector& v, Vector& u) const override {
+    u.resize(dim());
+    for (Index i = 0; i < m_; ++i) {
+      u(i) = x(i);
+      u(m_ + i) = x(m_ + i) / root_eps_;
+      u(2 * m_ + i) = v(i);
+      u(3 * m_ + i) = root_eps_ * v(m_ + i);
+    }
+  }
+  // g = -grad U = -sum_k d_k^3 grad d_k, with the springs d_k of spring() in x.
+  void force(const tsi::RealVector& x, tsi::RealVector& g) const override {
+    g.setZero(2 * m_);
+    for (Index k = 0; k <= m_; ++k) {
+      Real d = 0;
+      if (k < m_) d += x(k) - x(m_ + k);
+      if (k > 0) d -= x(k - 1) + x(m_ + k - 1);
+      const Real d3 = d * d * d;
+      if (k < m_) {
+        g(k) -= d3;
+        g(m_ + k) += d3;
+      }
+      if (k > 0) {
+        g(k - 1) += d3;
+        g(m_ + k - 1) += d3;
+      }
+    }
+  }
 
   Index dim() const override { return 4 * m_; }
   bool is_complex() const override { return false; }
