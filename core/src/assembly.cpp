@@ -373,7 +373,7 @@ Assembly assemble(const ResolvedSelection& resolved, const Registry& registry, c
                                   a.scheme_entry->info.name, pair,
                                   a.model->has_second_order_form()
                                       ? " (only \"direct\" does)"
-                                      : " (the model does not declare it; models that do: fput)"));
+                                      : " (the model does not declare it; models that do: fput, henon-heiles)"));
   if (binds) a.bind(options.h);
   return a;
 }

@@ -16,12 +16,41 @@ using tsi::MatrixRef;
 using tsi::Real;
 using tsi::Vector;
 
-class HenonHeiles final : public tsi::Model, public tsi::HamiltonianStructure, public tsi::FusedTauGrid {
+class HenonHeiles final : public tsi::Model,
+                          public tsi::HamiltonianStructure,
+                          public tsi::FusedTauGrid,
+                          public tsi::SecondOrderForm {
  public:
   explicit HenonHeiles(Real eps) : Model(eps) {}
 
   const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
   const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
+  const tsi::SecondOrderForm* second_order_form() const override { return this; }
+
+  // x = (q1, q2), x' = (p1/eps, p2): q1'' = -q1/eps^2 - (2/eps) q1 q2, q2'' = -q2 - q1^2 + q2^2,
+  // so Omega = diag(1/eps, 1) and g = (-(2/eps) q1 q2, -q1^2 + q2^2). The fast velocity is
+  // O(1/eps) for the paper's data: the energy of the second-order system is unbounded as
+  // eps -> 0, outside the bounded-energy regime of the trigonometric integrators' theory.
+  Index positions() const override { return 2; }
+  tsi::RealVector frequencies() const override {
+    tsi::RealVector omega(2);
+    omega << Real(1) / eps(), Real(1);
+    return omega;
+  }
+  void to_second_order(const Vector& u, tsi::RealVector& x, tsi::RealVector& v) const override {
+    x.resize(2);
+    v.resize(2);
+    x << u(0).real(), u(1).real();
+    v << u(2).real() / eps(), u(3).real();
+  }
+  void from_second_order(const tsi::RealVector& x, const tsi::RealVector& v, Vector& u) const override {
+    u.resize(4);
+    u << Complex(x(0)), Complex(x(1)), Complex(eps() * v(0)), Complex(v(1));
+  }
+  void force(const tsi::RealVector& x, tsi::RealVector& g) const override {
+    g.resize(2);
+    g << Real(-2) * x(0) * x(1) / eps(), -x(0) * x(0) + x(1) * x(1);
+  }
 
   Index dim() const override { return 4; }
   bool is_complex() const override { return false; }
