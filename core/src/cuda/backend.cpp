@@ -103,6 +103,18 @@ Backend& backend() {
 }
 const double* raw(const Complex* p) { return reinterpret_cast<const double*>(p); }
 double* raw(Complex* p) { return reinterpret_cast<double*>(p); }
+
+// A combination of `terms` terms from `start` (null: none), its terms to fill.
+cuda::Combination started(Backend& be, const Vector* start, size_t terms) {
+  if (terms > static_cast<size_t>(cuda::max_terms))
+    throw Error(fmt::format("tsi::device: a combination of {} terms (at most {} on the device)", terms,
+                            cuda::max_terms));
+  cuda::Combination c;
+  c.start = start ? raw(be.read(*start)) : nullptr;
+  c.count = static_cast<int>(terms);
+  return c;
+}
+
 }  // namespace
 
 bool available() { return true; }
@@ -182,14 +194,9 @@ void axpby(Real a, const Vector& x, Real b, const Vector& y, Vector& out) {
 
 void linear_combination(const Vector* start, std::span<const Diagonal* const> d, std::span<const Real> scalars,
                         std::span<const Vector* const> x, Vector& out) {
-  if (x.size() > static_cast<size_t>(cuda::max_terms))
-    throw Error(fmt::format("tsi::device: a combination of {} terms (at most {} on the device)", x.size(),
-                            cuda::max_terms));
   Backend& be = backend();
   const Index n = start ? start->size() : x.front()->size();
-  cuda::Combination c;
-  c.start = start ? raw(be.read(*start)) : nullptr;
-  c.count = static_cast<int>(x.size());
+  cuda::Combination c = started(be, start, x.size());
   for (size_t j = 0; j < x.size(); ++j) {
     cuda::Term& t = c.terms[j];
     t.x = raw(be.read(*x[j]));
@@ -205,14 +212,9 @@ void linear_combination(const Vector* start, std::span<const Diagonal* const> d,
 
 void vector_combination(const Vector* start, std::span<const Vector* const> d, std::span<const Vector* const> x,
                         Vector& out) {
-  if (x.size() > static_cast<size_t>(cuda::max_terms))
-    throw Error(fmt::format("tsi::device: a combination of {} terms (at most {} on the device)", x.size(),
-                            cuda::max_terms));
   Backend& be = backend();
   const Index n = start ? start->size() : x.front()->size();
-  cuda::Combination c;
-  c.start = start ? raw(be.read(*start)) : nullptr;
-  c.count = static_cast<int>(x.size());
+  cuda::Combination c = started(be, start, x.size());
   for (size_t j = 0; j < x.size(); ++j) c.terms[j] = {raw(be.read(*d[j])), 0.0, 1, raw(be.read(*x[j]))};
   cuda::combine(c, raw(be.write(out, n)), n);
 }

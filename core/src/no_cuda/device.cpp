@@ -1,5 +1,6 @@
-// tsi::device in a build without CUDA (TSI_WITH_CUDA=OFF): no scope can open, so the algebra
-// never calls the functions below (each throws if it were).
+// tsi::device in a build without CUDA (TSI_WITH_CUDA=OFF): no scope can open (current() is
+// null, inline in device.hpp), so the algebra never calls the functions below (each throws if
+// it were).
 #include "tsi/device.hpp"
 #include "tsi/error.hpp"
 
@@ -17,7 +18,6 @@ namespace {
 bool available() { return false; }
 int device_count() { return 0; }
 std::string describe() { return "this build has no CUDA backend"; }
-Backend* current() noexcept { return nullptr; }
 double bytes_in_use() { return 0.0; }
 
 // (the members are read here so that compilers see them used: this build never opens a scope)

@@ -86,6 +86,18 @@ struct Stencil {
 
 __device__ inline int wrap(int i, int n) { return i < 0 ? i + n : i >= n ? i - n : i; }
 
+// A particle's charge onto the n_y x n_x nodes of its stencil in `rho` (shared or device memory).
+template <int W>
+__device__ inline void deposit(const Geometry& g, const Stencil<W>& s, double* rho) {
+#pragma unroll
+  for (int b = 0; b < W; ++b) {
+    const int row = wrap(s.first_y + b, g.n_y) * g.n_x;
+    const double wy = g.weight * s.wy[b];
+#pragma unroll
+    for (int a = 0; a < W; ++a) atomicAdd(&rho[row + wrap(s.first_x + a, g.n_x)], wy * s.wx[a]);
+  }
+}
+
 // Column blockIdx.y, particles by a grid-stride loop over blockIdx.x: the block's sums in shared
 // memory (the column's n_y x n_x grid), then added to the column's density.
 template <int W>
@@ -97,14 +109,7 @@ __global__ void deposit_shared(Geometry g, const double* grid, long long dim, do
   const double* column = grid + 2 * dim * blockIdx.y;
   for (long long k = blockIdx.x * static_cast<long long>(blockDim.x) + threadIdx.x; k < g.particles;
        k += static_cast<long long>(gridDim.x) * blockDim.x) {
-    const Stencil<W> s(g, column, k);
-#pragma unroll
-    for (int b = 0; b < W; ++b) {
-      const int row = wrap(s.first_y + b, g.n_y) * g.n_x;
-      const double wy = g.weight * s.wy[b];
-#pragma unroll
-      for (int a = 0; a < W; ++a) atomicAdd(&local[row + wrap(s.first_x + a, g.n_x)], wy * s.wx[a]);
-    }
+    deposit(g, Stencil<W>(g, column, k), local);
   }
   __syncthreads();
   double* out = rho + static_cast<long long>(cells) * blockIdx.y;
@@ -120,14 +125,7 @@ __global__ void deposit_global(Geometry g, const double* grid, long long dim, do
   double* out = rho + static_cast<long long>(cells) * blockIdx.y;
   for (long long k = blockIdx.x * static_cast<long long>(blockDim.x) + threadIdx.x; k < g.particles;
        k += static_cast<long long>(gridDim.x) * blockDim.x) {
-    const Stencil<W> s(g, column, k);
-#pragma unroll
-    for (int b = 0; b < W; ++b) {
-      const int row = wrap(s.first_y + b, g.n_y) * g.n_x;
-      const double wy = g.weight * s.wy[b];
-#pragma unroll
-      for (int a = 0; a < W; ++a) atomicAdd(&out[row + wrap(s.first_x + a, g.n_x)], wy * s.wx[a]);
-    }
+    deposit(g, Stencil<W>(g, column, k), out);
   }
 }
 
