@@ -374,6 +374,14 @@ Assembly assemble(const ResolvedSelection& resolved, const Registry& registry, c
                                   a.model->has_second_order_form()
                                       ? " (only \"direct\" does)"
                                       : " (the model does not declare it; models that do: fput, henon-heiles)"));
+  if (traits.needs_charged_particle_form && !a.reformulation->charged_particle())
+    throw ConfigError("scheme.name",
+                      fmt::format("scheme \"{}\" needs the Lorentz-force form x' = v, v' = v x B(x) + E(x), which {} "
+                                  "does not provide{}",
+                                  a.scheme_entry->info.name, pair,
+                                  a.model->has_charged_particle_form()
+                                      ? " (only \"direct\" does)"
+                                      : " (the model does not declare it; models that do: cpd, charged-particle-3d)"));
   if (binds) a.bind(options.h);
   return a;
 }

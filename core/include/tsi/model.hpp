@@ -100,6 +100,8 @@ class TSI_API Model {
   virtual const ExactSolution* exact_solution() const { return nullptr; }
   /// The second-order form x'' = -Omega^2 x + g(x) (trigonometric integrators).
   virtual const SecondOrderForm* second_order_form() const { return nullptr; }
+  /// The Lorentz-force form x' = v, v' = v x B(x) + E(x) (Boris schemes).
+  virtual const ChargedParticleForm* charged_particle_form() const { return nullptr; }
 
   // ---- What the rest of tsi uses, built on the above (not virtual) -----------------------
 
@@ -107,6 +109,7 @@ class TSI_API Model {
   bool has_hamiltonian_structure() const { return hamiltonian() != nullptr; }
   bool has_exact_nonlinear_flow() const { return exact_nonlinear_flow() != nullptr; }
   bool has_second_order_form() const { return second_order_form() != nullptr; }
+  bool has_charged_particle_form() const { return charged_particle_form() != nullptr; }
   bool has_linear_remainder() const { return linear_remainder().size() > 0; }
 
   /// e^{A tau} applied to one state.

@@ -146,6 +146,25 @@ class TSI_API SecondOrderForm {
   virtual void force(const RealVector& x, RealVector& g) const = 0;
 };
 
+/// A position or field vector of three-dimensional space.
+using RealVector3 = Eigen::Matrix<Real, 3, 1>;
+
+/// The Lorentz-force form of a charged-particle model,
+///     x' = v,   v' = v x B(x) + E(x),   x, v in R^3,
+/// with B holding the model's 1/eps (B = B0/eps + B1(x)): what the Boris schemes take
+/// (SPEC.md section 8). A planar model (cpd) embeds its plane as x_3 = v_3 = 0, B along e_3
+/// and E in the plane.
+class TSI_API ChargedParticleForm {
+ public:
+  virtual ~ChargedParticleForm() = default;
+  /// The position and velocity of a model state u.
+  virtual void to_particle(const Vector& u, RealVector3& x, RealVector3& v) const = 0;
+  /// The model state of position x and velocity v.
+  virtual void from_particle(const RealVector3& x, const RealVector3& v, Vector& u) const = 0;
+  /// The magnetic field B(x) (with its 1/eps) and the electric field E(x) at x.
+  virtual void fields(const RealVector3& x, RealVector3& B, RealVector3& E) const = 0;
+};
+
 /// Physical variables different from the model's own (an initial value in a config, u_final,
 /// errors and their norm): without it they are the model's variables, errors in the Euclidean
 /// norm.

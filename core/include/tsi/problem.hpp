@@ -1,6 +1,7 @@
 #pragma once
 #include "tsi/diagonal.hpp"
 #include "tsi/export.hpp"
+#include "tsi/model_capabilities.hpp"
 #include "tsi/types.hpp"
 
 namespace tsi {
@@ -36,6 +37,19 @@ class TSI_API SecondOrderProblem {
   virtual void join(const RealVector& x, const RealVector& v, Vector& y) = 0;
   /// g(x); one evaluation of the problem's N (its work measure).
   virtual void force(const RealVector& x, RealVector& g) = 0;
+};
+
+/// A problem in the Lorentz-force form x' = v, v' = v x B(x) + E(x) (the direct problem of a
+/// model that declares tsi::ChargedParticleForm): its state read as a particle, and the fields.
+class TSI_API ChargedParticleProblem {
+ public:
+  virtual ~ChargedParticleProblem() = default;
+  /// The position and velocity of a state y of the problem.
+  virtual void split(const Vector& y, RealVector3& x, RealVector3& v) = 0;
+  /// The state y of position x and velocity v.
+  virtual void join(const RealVector3& x, const RealVector3& v, Vector& y) = 0;
+  /// B(x) and E(x); one evaluation of the problem's N (its work measure).
+  virtual void fields(const RealVector3& x, RealVector3& B, RealVector3& E) = 0;
 };
 
 /// The problem a stepper integrates:  y' = L y + N(t, y).
@@ -88,6 +102,9 @@ class TSI_API Problem {
   /// The problem in the second-order form, or null (the default: the model declares none, or
   /// the reformulation is not the direct one).
   virtual SecondOrderProblem* second_order() { return nullptr; }
+  /// The problem in the Lorentz-force form, or null (the default: the model declares none, or
+  /// the reformulation is not the direct one).
+  virtual ChargedParticleProblem* charged_particle() { return nullptr; }
 
   /// Evaluations of N (or of rhs) since construction: the work measure of a run.
   long evaluations() const { return evaluations_; }

@@ -35,6 +35,7 @@ struct TSI_API StepperTraits {
   bool needs_diagonal_linear_part = false;  ///< uses Problem::linear_multipliers (exponential schemes)
   bool needs_exact_flows = false;        ///< uses Problem::linear_flow and nonlinear_flow (splitting)
   bool needs_second_order_form = false;  ///< uses Problem::second_order (trigonometric integrators)
+  bool needs_charged_particle_form = false;  ///< uses Problem::charged_particle (Boris schemes)
   int initial_data_order = 1;            ///< two-scale prepared data needed for uniform order
   /// The prepared data needed instead on a model with a linear remainder R (ModelEntry::
   /// linear_remainder), when more (0: initial_data_order). The data's defect grows with

@@ -68,6 +68,34 @@ class Direct::SecondOrder final : public SecondOrderProblem {
   Vector values_;
 };
 
+// The model's Lorentz-force form through the packing, as the second-order form above.
+class Direct::ChargedParticle final : public ChargedParticleProblem {
+ public:
+  ChargedParticle(const Model& model, const ChargedParticleForm& form, const RealPacking& packing, long& evaluations)
+      : form_(form), packing_(packing), evaluations_(evaluations), values_(model.dim()) {}
+  void split(const Vector& y, RealVector3& x, RealVector3& v) override {
+    if (!packing_.on()) return form_.to_particle(y, x, v);
+    packing_.unpack(y.data(), values_.data());
+    form_.to_particle(values_, x, v);
+  }
+  void join(const RealVector3& x, const RealVector3& v, Vector& y) override {
+    if (!packing_.on()) return form_.from_particle(x, v, y);
+    form_.from_particle(x, v, values_);
+    y.resize(packing_.size());
+    packing_.pack(values_.data(), y.data());
+  }
+  void fields(const RealVector3& x, RealVector3& B, RealVector3& E) override {
+    ++evaluations_;
+    form_.fields(x, B, E);
+  }
+
+ private:
+  const ChargedParticleForm& form_;
+  const RealPacking& packing_;
+  long& evaluations_;
+  Vector values_;
+};
+
 Direct::Direct(std::shared_ptr<const Model> model, Variables variables, bool real_layout)
     : Reformulation(std::move(model)),
       physical_(variables == Variables::physical),
@@ -94,6 +122,8 @@ Direct::Direct(std::shared_ptr<const Model> model, Variables variables, bool rea
   }
   if (const SecondOrderForm* form = model_->second_order_form(); form && !physical_)
     second_order_ = std::make_unique<SecondOrder>(*model_, *form, packing_, evaluations_);
+  if (const ChargedParticleForm* form = model_->charged_particle_form(); form && !physical_)
+    charged_particle_ = std::make_unique<ChargedParticle>(*model_, *form, packing_, evaluations_);
 }
 
 const Vector& Direct::values_of(const Vector& y) {

@@ -41,6 +41,8 @@ class Direct final : public Reformulation {
 
   /// The model's second-order form on this state (model variables only), or null.
   SecondOrderProblem* second_order() override { return second_order_.get(); }
+  /// The model's Lorentz-force form on this state (model variables only), or null.
+  ChargedParticleProblem* charged_particle() override { return charged_particle_.get(); }
 
   Vector prepare(const Vector& u0) override { return packing_.packed(physical_ ? model_->to_physical(u0) : u0); }
   Vector read_back(const Vector& y, Real /*t*/) override {
@@ -69,6 +71,8 @@ class Direct final : public Reformulation {
   Vector x_, result_;  // the state and N as d values, where the packing is on
   class SecondOrder;
   std::unique_ptr<SecondOrderProblem> second_order_;  // where the model declares the form
+  class ChargedParticle;
+  std::unique_ptr<ChargedParticleProblem> charged_particle_;  // likewise
 };
 
 }  // namespace tsi

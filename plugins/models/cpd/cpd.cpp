@@ -35,7 +35,8 @@ class ChargedParticle final : public tsi::Model,
                               public tsi::HamiltonianStructure,
                               public tsi::FusedTauGrid,
                               public tsi::ExactNonlinearFlow,
-                              public tsi::PhysicalVariables {
+                              public tsi::PhysicalVariables,
+                              public tsi::ChargedParticleForm {
  public:
   ChargedParticle(Real eps, Potential potential) : Model(eps), potential_(potential) {}
   using Model::linear_flow;
@@ -45,6 +46,7 @@ class ChargedParticle final : public tsi::Model,
   const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
   const tsi::ExactNonlinearFlow* exact_nonlinear_flow() const override { return this; }
   const tsi::PhysicalVariables* physical_variables() const override { return this; }
+  const tsi::ChargedParticleForm* charged_particle_form() const override { return this; }
 
   Index dim() const override { return 4; }
   bool is_complex() const override { return false; }
@@ -240,6 +242,28 @@ class ChargedParticle final : public tsi::Model,
     const Real inv = 1.0 / (2.0 * eps());
     x << u(0), u(1), (u(2) + u(1)) * inv, (u(3) - u(0)) * inv;
     return x;
+  }
+
+  // The Lorentz-force form in the plane x_3 = 0: (1/eps) B v = v x e_3 / eps, so B = e_3 / eps
+  // and E = (g, 0); x = q, v = (p + B q) / (2 eps) as in to_physical.
+  void to_particle(const Vector& u, tsi::RealVector3& x, tsi::RealVector3& v) const override {
+    const Vector physical = to_physical(u);
+    x << physical(0).real(), physical(1).real(), 0;
+    v << physical(2).real(), physical(3).real(), 0;
+  }
+  void from_particle(const tsi::RealVector3& x, const tsi::RealVector3& v, Vector& u) const override {
+    Vector physical(4);
+    physical << x(0), x(1), v(0), v(1);
+    u = from_physical(physical);
+  }
+  void fields(const tsi::RealVector3& x, tsi::RealVector3& B, tsi::RealVector3& E) const override {
+    B << 0, 0, 1 / eps();
+    if (potential_ == Potential::Coulomb) {
+      const Real r2 = x(0) * x(0) + x(1) * x(1), k = 1 / (r2 * std::sqrt(r2));
+      E << k * x(0), k * x(1), 0;
+    } else {
+      E << -x(0), -x(1), 0;
+    }
   }
 
  private:
