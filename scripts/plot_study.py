@@ -5,6 +5,8 @@ the figures can be restyled without rerunning anything:
     python3 scripts/plot_study.py OUT_DIR
 
 convergence:    convergence.png     error against h, one panel per scheme, one curve per eps
+                side_by_side.png    (two schemes or more) error against h, one panel per eps,
+                                    one colour and marker per scheme in every panel
 conservation:   conservation.png    err_H, err_I, err_m against t, one row per scheme, and a
                                     panel more per invariant the models declare (err_P,
                                     abs_err_P, err_mu: the change columns of invariants.csv)
@@ -84,6 +86,51 @@ def convergence_figure(rows, title):
     return fig
 
 
+# Twenty colours, the ten strong hues first, then their light ones, and a marker cycle of
+# another length: twelve schemes or more stay apart in a plot and in its legend.
+_ORDER = list(range(0, 20, 2)) + list(range(1, 20, 2))
+_MARKERS = "osD^v<>pPXh*"
+
+
+def series_style(k):
+    """Colour and marker of the k-th series: the same for a scheme in every panel."""
+    return {"color": plt.get_cmap("tab20")(_ORDER[k % 20]), "marker": _MARKERS[k % len(_MARKERS)]}
+
+
+def side_by_side_figure(rows, title):
+    """Every scheme in one panel per eps: error against h. Failed runs are crosses in the scheme's
+    colour along the panel's top, and the legend counts them."""
+    failed = [r for r in rows if not number(r["error"])]
+    good = [r for r in rows if number(r["error"])]
+    names = list(dict.fromkeys(series_name(r) for r in rows))
+    eps_values = sorted({number(r["eps"]) for r in rows}, reverse=True)
+    fig, axes = panels(len(eps_values), width=5.2, height=4.2)
+    for ax, eps in zip(axes, eps_values):
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        for k, name in enumerate(names):
+            pts = sorted((number(r["h"]), number(r["error"])) for r in good
+                         if series_name(r) == name and number(r["eps"]) == eps)
+            if pts:
+                ax.plot(*zip(*pts), "-", lw=1, markersize=4, **series_style(k))
+        top = ax.get_ylim()[1] if ax.lines else 1.0
+        for k, name in enumerate(names):
+            lost = [number(r["h"]) for r in failed if series_name(r) == name and number(r["eps"]) == eps]
+            if lost:
+                ax.plot(lost, [top] * len(lost), "x", color=series_style(k)["color"], markersize=8, clip_on=False)
+        ax.set(xlabel="time step h", ylabel="relative error at t_end", title=f"eps = {fraction(eps)}")
+        ax.grid(True, which="both", alpha=0.3)
+    handles = []
+    for k, name in enumerate(names):
+        lost = sum(1 for r in failed if series_name(r) == name)
+        label = name + (f" ({lost} failed: x)" if lost else "")
+        handles.append(plt.Line2D([], [], lw=1, markersize=5, label=label, **series_style(k)))
+    fig.legend(handles=handles, loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
 CHANGES = ("err_H", "err_I", "err_m")
 
 
@@ -100,6 +147,14 @@ def declared_changes(inv):
     return [k for k in inv if k.startswith(("err_", "abs_err_")) and k not in CHANGES]
 
 
+def recorded_values(inv):
+    """The values a model records without tracking a change (FPUT's stiff energies I_1 .. I_m, a
+    plasma's electric energy): columns with no err_ or abs_err_ column of their own."""
+    skip = {"t", "tau_roughness", "tau_spread", "H", "I", "m"}
+    return [k for k in inv if k not in skip and not k.startswith(("err_", "abs_err_"))
+            and f"err_{k}" not in inv and f"abs_err_{k}" not in inv]
+
+
 def read_runs(rows, out):
     """Every run's invariants.csv under OUT/runs/, by run id (runs without one left out)."""
     runs = {}
@@ -114,9 +169,13 @@ def conservation_figure(rows, title, runs):
     """`runs`: each run's invariants.csv columns by run id (read_runs)."""
     names = list(dict.fromkeys(series_name(r) for r in rows))
     keys = list(CHANGES)
+    values = []
     for inv in runs.values():
         keys += [k for k in declared_changes(inv) if k not in keys]
-    fig, axes = plt.subplots(len(names), len(keys), figsize=(5 * len(keys), 3.2 * len(names)), squeeze=False)
+        values += [k for k in recorded_values(inv) if k not in values]
+    # A last column draws the recorded values themselves (FPUT's exchange I_1 -> I_2 -> I_3).
+    columns = len(keys) + (1 if values else 0)
+    fig, axes = plt.subplots(len(names), columns, figsize=(5 * columns, 3.2 * len(names)), squeeze=False)
     several_models = len({r["model"] for r in rows}) > 1
     for i, name in enumerate(names):
         for k, r in enumerate(r for r in rows if series_name(r) == name and r["id"] in runs):
@@ -130,14 +189,25 @@ def conservation_figure(rows, title, runs):
                 pts = [(t, e) for t, e in zip(inv["t"], inv.get(key, ())) if t > 0 and e and e > 0]
                 if pts:  # a run keeps its colour in every panel, also where other runs have no curve
                     axes[i][j].semilogy(*zip(*pts), lw=0.8, color=f"C{k % 10}", label=label)
+            for v, key in enumerate(values):  # a colour per value, a line style per run
+                pts = [(t, y) for t, y in zip(inv["t"], inv.get(key, ())) if y is not None]
+                if pts:
+                    axes[i][-1].plot(*zip(*pts), ["-", "--", ":", "-."][k % 4], lw=0.9, color=f"C{v % 10}",
+                                     label=f"{key}, {label}")
         for j, key in enumerate(keys):
             ax = axes[i][j]
             ax.set(xlabel="t", ylabel=key, title=f"{name}: {key}")
             ax.grid(True, which="both", alpha=0.3)
             if ax.lines:
                 ax.legend(fontsize=7)
+        if values:
+            ax = axes[i][-1]
+            ax.set(xlabel="t", ylabel="value", title=f"{name}: " + ", ".join(values))
+            ax.grid(True, alpha=0.3)
+            if ax.lines:
+                ax.legend(fontsize=7)
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.4 / fig.get_figheight()))  # room for the title
     return fig
 
 
@@ -145,9 +215,8 @@ def work_precision_figure(rows, title):
     rows = [r for r in rows if number(r["error"]) and number(r["wall_seconds"])]
     fig, axes = plt.subplots(1, 2, figsize=(14, 5.2))
     eps_values = sorted({number(r["eps"]) for r in rows}, reverse=True)
-    styles = ["o-", "s--", "^:", "v-.", "D-", "P--"]
-    # Several eps: a colour per eps and a line style per scheme; one eps: a colour per scheme.
-    by_eps = len(eps_values) > 1
+    lines = ["-", "--", ":", "-."]
+    # A colour and marker per scheme (series_style), a line style per eps.
     for k, name in enumerate(dict.fromkeys(series_name(r) for r in rows)):
         for i, eps in enumerate(eps_values):
             mine = [r for r in rows if series_name(r) == name and number(r["eps"]) == eps]
@@ -155,8 +224,8 @@ def work_precision_figure(rows, title):
                 continue
             for ax, x in zip(axes, ("wall_seconds", "rhs_evals")):
                 pts = sorted((number(r[x]), number(r["error"])) for r in mine)
-                ax.loglog(*zip(*pts), styles[k % len(styles)] if by_eps else "o-",
-                          color=f"C{(i if by_eps else k) % 10}", label=f"{name}, eps = {fraction(eps)}")
+                ax.loglog(*zip(*pts), lines[i % len(lines)], markersize=4, label=f"{name}, eps = {fraction(eps)}",
+                          **series_style(k))
     axes[0].set(xlabel="wall time [s]", ylabel="relative error at t_end", title="error against time")
     axes[1].set(xlabel="nonlinearity evaluations (two-scale: one covers all tau points)",
                 ylabel="relative error at t_end", title="error against evaluations")
@@ -191,6 +260,10 @@ def main():
     name, dpi = FILES[kind]
     fig.savefig(os.path.join(out, name), dpi=dpi)
     print(f"  plot: {os.path.join(out, name)}")
+    if kind == "convergence" and len({series_name(r) for r in rows}) > 1:
+        path = os.path.join(out, "side_by_side.png")
+        side_by_side_figure(rows, title).savefig(path, dpi=110, bbox_inches="tight")
+        print(f"  plot: {path}")
 
 
 if __name__ == "__main__":

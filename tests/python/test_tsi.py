@@ -674,13 +674,33 @@ class PlotTests(unittest.TestCase):
         lines = fig.axes[0].get_lines()
         self.assertEqual(len(lines), 3)
         self.assertEqual(len({line.get_color() for line in lines}), 3)
-        # Two eps: one colour per eps, the schemes told apart by their line styles.
+        # Two eps: a scheme keeps its colour and marker, the eps are told apart by line styles.
         spec["vary"]["model.eps"] = [1e-2, 1e-3]
         fig = tsi.plot.work_precision(tsi.study(spec, jobs=1))
         lines = fig.axes[0].get_lines()
         self.assertEqual(len(lines), 6)
-        self.assertEqual(len({line.get_color() for line in lines}), 2)
-        self.assertEqual(len({line.get_linestyle() for line in lines}), 3)
+        self.assertEqual(len({line.get_color() for line in lines}), 3)
+        self.assertEqual(len({line.get_marker() for line in lines}), 3)
+        self.assertEqual(len({line.get_linestyle() for line in lines}), 2)
+
+    def test_side_by_side_names_every_scheme_in_one_colour_each(self):
+        from tsi import _plot_study
+        # Thirteen series: colours and markers stay apart, and the legend names each.
+        styles = [_plot_study.series_style(k) for k in range(13)]
+        self.assertEqual(len({str(s["color"]) for s in styles}), 13)
+        rows = []
+        for k in range(13):
+            for eps in (1.0, 1e-3):
+                for h in (0.5, 0.25):
+                    failed = k == 12 and h == 0.5
+                    rows.append({"label": f"scheme {k}", "scheme": "se1", "eps": str(eps), "h": str(h),
+                                 "error": "" if failed else str(h * h * (k + 1)),
+                                 "status": "blow-up" if failed else "completed"})
+        fig = _plot_study.side_by_side_figure(rows, "thirteen")
+        self.assertEqual(len([ax for ax in fig.axes if ax.get_visible()]), 2)
+        labels = [t.get_text() for t in fig.legends[0].get_texts()]
+        self.assertEqual(len(labels), 13)
+        self.assertEqual(labels[12], "scheme 12 (2 failed: x)")
 
     def test_the_wrong_kind_is_refused(self):
         s = tsi.study({"kind": "conservation", "base": HH, "vary": {"time.h": [0.5]}}, jobs=1)
