@@ -373,7 +373,7 @@ Assembly assemble(const ResolvedSelection& resolved, const Registry& registry, c
                                   a.scheme_entry->info.name, pair,
                                   a.model->has_second_order_form()
                                       ? " (only \"direct\" does)"
-                                      : " (the model does not declare it; models that do: fput, henon-heiles)"));
+                                      : " (the model does not declare it; models that do: fput, henon-heiles, klein-gordon)"));
   if (traits.needs_charged_particle_form && !a.reformulation->charged_particle())
     throw ConfigError("scheme.name",
                       fmt::format("scheme \"{}\" needs the Lorentz-force form x' = v, v' = v x B(x) + E(x), which {} "

@@ -201,3 +201,61 @@ TEST_CASE("trigonometric on henon-heiles: second order at eps = 1, not uniformly
   CHECK(errors_at_h64[1] > 2 * errors_at_h64[0]);
   CHECK(errors_at_h64[2] > 2 * errors_at_h64[1]);
 }
+
+TEST_CASE("klein-gordon's second-order form in 1-D and 2-D: the model's own equation, read as q'' = -Omega^2 q + g") {
+  // The form's x, x' and x'' against central differences of the direct problem's flow
+  // (its rhs, independent of the form): x' = v and v' = -Omega^2 x + g(x) along u' = F(u).
+  for (const Json& params : {Json{{"n_x", 16}}, Json{{"dims", 2}, {"n_x", 8}}}) {
+    auto model = Harness::instance().model_with("klein-gordon", 0.25, params);
+    const tsi::SecondOrderForm* form = model->second_order_form();
+    REQUIRE(form);
+    auto direct = Harness::instance().reformulation("direct", model);
+    const Vector u = model->initial_value();
+    Vector f(u.size());
+    direct->rhs(0, u, f);
+    tsi::RealVector x, v, x_plus, v_plus, x_minus, v_minus, g;
+    form->to_second_order(u, x, v);
+    const double delta = 1e-5;
+    form->to_second_order(u + delta * f, x_plus, v_plus);
+    form->to_second_order(u - delta * f, x_minus, v_minus);
+    form->force(x, g);
+    const tsi::RealVector omega = form->frequencies();
+    const tsi::RealVector dx = (x_plus - x_minus) / (2 * delta), dv = (v_plus - v_minus) / (2 * delta);
+    const tsi::RealVector acceleration = -omega.array().square().matrix().cwiseProduct(x) + g;
+    CAPTURE(params.dump());
+    CHECK((dx - v).norm() <= 1e-8 * v.norm());
+    CHECK((dv - acceleration).norm() <= 1e-8 * acceleration.norm());
+    Vector back;
+    form->from_second_order(x, v, back);
+    CHECK((back - u).norm() <= 1e-14 * u.norm());
+  }
+}
+
+TEST_CASE("trigonometric on klein-gordon: second order at eps = 1 and 1/16, not uniformly accurate as eps falls") {
+  // Bao and Dong's exponential wave integrators are this family on Klein-Gordon; in the
+  // non-relativistic limit they need h = O(eps): at a fixed h the error grows like 1/eps^2.
+  auto error_at = [](double eps, long n) {
+    auto model = Harness::instance().model_with("klein-gordon", eps, {{"n_x", 16}});
+    auto direct = Harness::instance().reformulation("direct", model);
+    const Vector x = tsi::test::solve(*model, *direct, *Harness::instance().scheme("trigonometric", Json::object()), 1.0, n);
+    const Vector& reference = tsi::test::reference_solution("klein-gordon", eps, 1.0);
+    return (x - reference).norm() / reference.norm();
+  };
+  for (const double eps : {1.0, 1.0 / 16}) {
+    std::vector<double> hs, errors;
+    for (const long n : {64, 128, 256}) {
+      hs.push_back(1.0 / static_cast<double>(n));
+      errors.push_back(error_at(eps, n));
+    }
+    const tsi::OrderFit fit = tsi::fit_order(hs, errors, 1e-12);
+    REQUIRE(fit.measurable);
+    MESSAGE(fmt::format("klein-gordon eps = {}: {:.2e} .. {:.2e}, order {:.2f}", eps, errors.front(), errors.back(),
+                        fit.order));
+    CHECK(fit.order > 1.95);
+    CHECK(fit.order < 2.05);
+  }
+  const double e1 = error_at(1.0, 64), e16 = error_at(1.0 / 16, 64), e256 = error_at(1.0 / 256, 64);
+  MESSAGE(fmt::format("klein-gordon at h = 1/64: {:.2e}, {:.2e}, {:.2e} at eps = 1, 1/16, 1/256", e1, e16, e256));
+  CHECK(e16 > 30 * e1);
+  CHECK(e256 > 30 * e16);
+}

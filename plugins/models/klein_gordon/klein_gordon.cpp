@@ -99,7 +99,8 @@ class KleinGordon final : public tsi::Model,
                           public tsi::FusedTauGrid,
                           public tsi::ExactNonlinearFlow,
                           public tsi::PhysicalVariables,
-                          public tsi::ExactSolution {
+                          public tsi::ExactSolution,
+                          public tsi::SecondOrderForm {
  public:
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
   // wave: the plane wave of model.initial = "plane-wave"; data: z and e^2 z_t of model.z0 and
@@ -139,6 +140,7 @@ class KleinGordon final : public tsi::Model,
   // The linear equation's plane wave (lambda = 0) is exact.
   const tsi::ExactSolution* exact_solution() const override { return wave_ && lambda_ == 0.0 ? this : nullptr; }
   const tsi::PhysicalVariables* physical_variables() const override { return this; }
+  const tsi::SecondOrderForm* second_order_form() const override { return this; }
 
   // e^{JM tau} = e^{i tau}: one phase for every coordinate.
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
@@ -319,6 +321,64 @@ class KleinGordon final : public tsi::Model,
     w.col(0) = inverse_a_.cwiseProduct(c);
     b.backward();
     return w.col(0) / std::sqrt(volume_);
+  }
+
+  // ---- The second-order form ------------------------------------------------------------
+  // q_k'' = -omega_k^2 q_k - (lambda / e^2) (z^3)_k for the Fourier coefficients q_k of z (the
+  // header's q' = p / e^2, p' = -(k^2 + 1/e^2) q - lambda (z^3)), omega_k = sqrt(1 + eps k^2) / eps:
+  // diagonal in Fourier. Positions are (Re q_k, Im q_k) over the whole spectrum (2N reals; q_{-k} =
+  // conj q_k, which the integrator keeps: its update is linear with the same omega for k and -k
+  // and the force is the transform of a real grid function), velocities those of p_k / e^2.
+  Index positions() const override { return 2 * n_x_; }
+  tsi::RealVector frequencies() const override {
+    tsi::RealVector omega(2 * n_x_);
+    for (Index j = 0; j < n_x_; ++j)
+      omega(j) = omega(n_x_ + j) = std::sqrt(1.0 + eps() * grid_.laplacian_symbol()(j)) / eps();
+    return omega;
+  }
+  // z = Re v and (1 - e^2 lap)^{-1/2} p = -Im v on the grid; p_k = a_k^2 (that)_k.
+  void to_second_order(const Vector& c, tsi::RealVector& x, tsi::RealVector& v) const override {
+    const Vector physical = to_physical(c);
+    std::lock_guard<std::mutex> lock(mutex_);
+    tsi::GridTransforms& b = batch(1);
+    auto w = b.data();
+    w.col(0) = physical.real().cast<Complex>();
+    b.forward();
+    const Vector q = w.col(0) / point_count();
+    w.col(0) = (-physical.imag()).cast<Complex>();
+    b.forward();
+    const Vector p = (w.col(0) / point_count()).cwiseQuotient(inverse_a_.array().square().matrix().cast<Complex>());
+    x.resize(2 * n_x_);
+    v.resize(2 * n_x_);
+    x << q.real(), q.imag();
+    v << p.real() / eps(), p.imag() / eps();
+  }
+  void from_second_order(const tsi::RealVector& x, const tsi::RealVector& v, Vector& c) const override {
+    FieldAndMomentum data;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      tsi::GridTransforms& b = batch(1);
+      auto w = b.data();
+      w.col(0) = x.head(n_x_).cast<Complex>() + Complex(0, 1) * x.tail(n_x_).cast<Complex>();
+      b.backward();
+      data.z = w.col(0).real();
+      w.col(0) = eps() * (v.head(n_x_).cast<Complex>() + Complex(0, 1) * v.tail(n_x_).cast<Complex>());
+      b.backward();
+      data.p = w.col(0).real();
+    }
+    c = from_field_and_momentum(data);
+  }
+  // g_k = -(lambda / e^2) (z^3)_k, z = Re backward(q).
+  void force(const tsi::RealVector& x, tsi::RealVector& g) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    tsi::GridTransforms& b = batch(1);
+    auto w = b.data();
+    w.col(0) = x.head(n_x_).cast<Complex>() + Complex(0, 1) * x.tail(n_x_).cast<Complex>();
+    b.backward();
+    w.col(0) = (-lambda_ / eps()) * w.col(0).real().array().cube().matrix().cast<Complex>();
+    b.forward();
+    g.resize(2 * n_x_);
+    g << w.col(0).real() / point_count(), w.col(0).imag() / point_count();
   }
 
   // Discrete L2 norm of grid samples.

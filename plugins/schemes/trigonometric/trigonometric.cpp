@@ -110,7 +110,7 @@ tsi::SecondOrderProblem& second_order_of(tsi::Problem& problem) {
   if (!form)
     throw tsi::ConfigError("scheme.name", "got \"trigonometric\" on a problem without the second-order form "
                                           "x'' = -Omega^2 x + g(x); expected the direct reformulation of a model that "
-                                          "declares it (fput, henon-heiles)");
+                                          "declares it (fput, henon-heiles, klein-gordon)");
   return *form;
 }
 
@@ -183,7 +183,7 @@ void register_trigonometric(tsi::Registry& registry) {
   entry.info.aliases = {"gautschi-type"};
   entry.info.summary =
       "trigonometric (Gautschi-type) integrators for x'' = -Omega^2 x + g(x), one-step form with a filter (direct "
-      "problem of a model with the second-order form: fput, Henon-Heiles)";
+      "problem of a model with the second-order form: fput, Henon-Heiles, Klein-Gordon)";
   entry.info.params = {tsi::string_param("filter", "hairer-lubich",
                                          "the filter functions psi and phi (SPEC.md section 8): gautschi (1961), "
                                          "deuflhard (1979), garcia-archilla (Sanz-Serna, Skeel 1999), hochbruck-lubich "
