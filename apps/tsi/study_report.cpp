@@ -485,9 +485,9 @@ std::string study_text(const Study& study, const Json& rows) {
     };
     size_t width = 24;
     for (const auto& row : rows) width = std::max(width, row_name(row).size() + 2);
-    s += conservation ? fmt::format("\n  {:<{}}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}", "scheme", width, "eps", "h", "max err_H",
+    s += conservation ? fmt::format("\n  {:<{}}{:>10}{:>11}{:>11}{:>11}{:>11}{:>11}", "scheme", width, "eps", "h", "max err_H",
                                     "drift_H", "max err_I", "max err_m")
-                      : fmt::format("\n  {:<{}}{:>10}{:>9}{:>10}{:>11}{:>12}{:>10}\n", "scheme", width, "eps", "h", "tol",
+                      : fmt::format("\n  {:<{}}{:>10}{:>11}{:>10}{:>11}{:>12}{:>10}\n", "scheme", width, "eps", "h", "tol",
                                     "error", "rhs evals", "wall s");
     if (conservation) {
       for (const auto& c : declared) s += fmt::format("{:>{}}", "max " + c, declared_width(c));
@@ -496,13 +496,13 @@ std::string study_text(const Study& study, const Json& rows) {
     for (const auto& row : rows) {
       const std::string name = row_name(row);
       if (conservation) {
-        s += fmt::format("  {:<{}}{:>10}{:>9}{:>11}{:>11}{:>11}{:>11}", name, width, fraction(row["eps"]), fraction(row["h"]),
+        s += fmt::format("  {:<{}}{:>10}{:>11}{:>11}{:>11}{:>11}{:>11}", name, width, fraction(row["eps"]), fraction(row["h"]),
                          cell(row["err_H"]), cell(row["drift_H"], "{:.2e}"), cell(row["err_I"]), cell(row["err_m"]));
         for (const auto& c : declared) s += fmt::format("{:>{}}", cell(row.value(c, Json())), declared_width(c));
         s += fmt::format("{:>11}  {}\n", cell(row["t_reached"], "{:g}"), row["status"].get<std::string>());
       } else {
         const Json tol = row["varied"].value("scheme.tol", Json());
-        s += fmt::format("  {:<{}}{:>10}{:>9}{:>10}{:>11}{:>12}{:>10}\n", name, width, fraction(row["eps"]),
+        s += fmt::format("  {:<{}}{:>10}{:>11}{:>10}{:>11}{:>12}{:>10}\n", name, width, fraction(row["eps"]),
                          fraction(row["h"]), tol.is_number() ? fmt::format("{:.0e}", tol.get<double>()) : "",
                          cell(row["error"]), row["rhs_evals"].is_number() ? row["rhs_evals"].dump() : "-",
                          cell(row["wall_seconds"], "{:.4f}"));
@@ -513,11 +513,13 @@ std::string study_text(const Study& study, const Json& rows) {
     const Json work = work_at_error(rows, work_targets);
     s += "\n  wall time to reach a relative error (log-log interpolation between runs; <= : the cheapest run,\n"
          "  when every run is already below the error):\n";
-    s += fmt::format("  {:<24}{:>12}", "scheme", "eps");
+    size_t name_width = 24;  // the longest name and two spaces, so that a long label keeps its columns
+    for (const auto& w : work) name_width = std::max(name_width, w["name"].get<std::string>().size() + 2);
+    s += fmt::format("  {:<{}}{:>12}", "scheme", name_width, "eps");
     for (const double target : work_targets) s += fmt::format("{:>14}", fmt::format("error {:.0e}", target));
     s += "\n";
     for (const auto& w : work) {
-      s += fmt::format("  {:<24}{:>12}", w["name"].get<std::string>(), fraction(w["eps"]));
+      s += fmt::format("  {:<{}}{:>12}", w["name"].get<std::string>(), name_width, fraction(w["eps"]));
       for (size_t k = 0; k < work_targets.size(); ++k) s += fmt::format("{:>14}", work_cell(w, k));
       s += "\n";
     }
