@@ -202,11 +202,19 @@ TEST_CASE("trigonometric on henon-heiles: second order at eps = 1, not uniformly
   CHECK(errors_at_h64[2] > 2 * errors_at_h64[1]);
 }
 
-TEST_CASE("klein-gordon's second-order form in 1-D and 2-D: the model's own equation, read as q'' = -Omega^2 q + g") {
+TEST_CASE("klein-gordon's second-order form in 1-D to 3-D, real and complex z: the model's own equation, read as "
+          "q'' = -Omega^2 q + g") {
   // The form's x, x' and x'' against central differences of the direct problem's flow
   // (its rhs, independent of the form): x' = v and v' = -Omega^2 x + g(x) along u' = F(u).
-  for (const Json& params : {Json{{"n_x", 16}}, Json{{"dims", 2}, {"n_x", 8}}}) {
-    auto model = Harness::instance().model_with("klein-gordon", 0.25, params);
+  const std::vector<std::pair<std::string, Json>> cases = {
+      {"klein-gordon", {{"n_x", 16}}},
+      {"klein-gordon", {{"dims", 2}, {"n_x", 8}}},
+      {"klein-gordon", {{"dims", 3}, {"n_x", 4}}},
+      {"klein-gordon-complex", {{"n_x", 16}}},
+      {"klein-gordon-complex", {{"dims", 2}, {"n_x", 8}}}};
+  for (const auto& c : cases) {
+    const Json& params = c.second;
+    auto model = Harness::instance().model_with(c.first, 0.25, params);
     const tsi::SecondOrderForm* form = model->second_order_form();
     REQUIRE(form);
     auto direct = Harness::instance().reformulation("direct", model);
@@ -222,6 +230,7 @@ TEST_CASE("klein-gordon's second-order form in 1-D and 2-D: the model's own equa
     const tsi::RealVector omega = form->frequencies();
     const tsi::RealVector dx = (x_plus - x_minus) / (2 * delta), dv = (v_plus - v_minus) / (2 * delta);
     const tsi::RealVector acceleration = -omega.array().square().matrix().cwiseProduct(x) + g;
+    CAPTURE(c.first);
     CAPTURE(params.dump());
     CHECK((dx - v).norm() <= 1e-8 * v.norm());
     CHECK((dv - acceleration).norm() <= 1e-8 * acceleration.norm());

@@ -479,8 +479,7 @@ tsi::RealVector real_samples(const tsi::Json& value, const std::string& field, c
     if (im != 0.0)
       throw tsi::ConfigError(entry, "got " + shown(v) +
                                         ", expected a real number: this model's z is real; complex z (Chartier, "
-                                        "Crouseilles, Lemou, Mehats) needs a complex Klein-Gordon model, which this "
-                                        "one is not");
+                                        "Crouseilles, Lemou, Mehats) is the model klein-gordon-complex");
     samples(static_cast<Index>(j)) = re;
   }
   return samples;

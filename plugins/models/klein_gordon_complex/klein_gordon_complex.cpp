@@ -1,0 +1,353 @@
+// The nonlinear Klein-Gordon equation with complex z (SPEC.md section 8; the form of Chartier,
+// Crouseilles, Lemou and Mehats, Numer. Math. 129 (2015)):
+//     eps z_tt - lap z + z / eps + lambda |z|^2 z = 0,   x in [0, 2 pi)^d periodic, d = 1, 2, 3,
+// Fourier pseudospectral on tsi::SpectralGrid's N points. The real `klein-gordon` model is the
+// case z real (its eps the same, e^2 there).
+//
+// Variables. With <D> = (1 - eps lap)^{1/2} (symbol a_k^2 = sqrt(1 + eps |k|^2)):
+//     u = z - i <D>^{-1} (eps z_t),   v = conj z - i <D>^{-1} (eps conj z_t),   z = (u + conj v) / 2,
+//     u_t = (i/eps) <D> u + i lambda <D>^{-1} (|z|^2 z),   v_t = (i/eps) <D> v + i lambda <D>^{-1} conj(|z|^2 z)
+// (derived from the equation; MicroMacro.jl's ftau.jl writes the field as -i llambda with
+// llambda = -lambda, the same). The state is c = (c_u, c_v), c_u = sqrt(2 pi)^d / N a forward(u)
+// (as the real model's c, so that sum |c|^2 is a discrete L2 norm and e^{i tau} is the fast flow):
+//     c' = (i/eps) c + i A c + i lambda (2 pi)^{d/2} / N a^{-1} (forward(|z|^2 z), forward(conj(|z|^2 z))),
+// A_k = |k|^2 / (1 + sqrt(1 + eps |k|^2)) the remainder, integrated exactly. It is Hamiltonian with
+// J = i, M = I and H1 = (lambda / 2) (2 pi)^d / N sum_j |z_j|^4: H = <c, c>/(2 eps) + sum A |c|^2 / 2 + H1
+// is the energy int eps |z_t|^2 + |grad z|^2 + |z|^2 / eps + lambda |z|^4 / 2 dx. The charge
+// Q = Im int conj(z) eps z_t dx is conserved too (the equation's U(1) symmetry); it is recorded.
+// The exact flow of c' = f(c) alone is c + t f(c) (z, hence f, is constant along it): Strang splitting.
+// The second-order form z_k'' = -omega_k^2 z_k - (lambda/eps) (|z|^2 z)_k, omega_k = sqrt(1 + eps |k|^2)/eps:
+// the trigonometric integrators.
+//
+// Physical variables (model.u0, u_final, errors): the grid samples of u, then of v (2N complex
+// values, shape (2, n_x[, n_y[, n_z]])), as MicroMacro.jl keeps them; errors in the discrete L2 norm.
+//
+// Data (model.data), in 1-D (products over the directions in 2-D and 3-D, as the real model's):
+//   cos-sin        z(0) = (1 + i) cos x, eps z_t(0) = (1 - i) sin x (MicroMacro.jl's data set 3,
+//                  with its reference solutions at T = 0.25, N = 128: tests/data/rivals/)
+//   faou-schratz   z(0) = cos x, eps z_t(0) = sin(x) / 4 + cos(x) / 2 (Faou and Schratz's 6.3,
+//                  MicroMacro.jl's data set 2)
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "tsi/error.hpp"
+#include "tsi/model.hpp"
+#include "tsi/phase.hpp"
+#include "tsi/plugin.hpp"
+#include "tsi/spectral_grid.hpp"
+
+namespace {
+
+using tsi::Complex;
+using tsi::ConstMatrixRef;
+using tsi::Index;
+using tsi::MatrixRef;
+using tsi::Real;
+using tsi::Vector;
+
+enum class Data { cos_sin, faou_schratz };
+
+class KleinGordonComplex final : public tsi::Model,
+                                 public tsi::HamiltonianStructure,
+                                 public tsi::ExactNonlinearFlow,
+                                 public tsi::PhysicalVariables,
+                                 public tsi::SecondOrderForm {
+ public:
+  KleinGordonComplex(Real eps, std::vector<int> shape, Real lambda, Data data, tsi::ThreadLimit fftw_threads)
+      : Model(eps),
+        grid_(std::move(shape)),
+        n_(grid_.points()),
+        lambda_(lambda),
+        data_(data),
+        volume_(std::pow(tsi::two_pi, grid_.dims())),
+        a_(n_),
+        inverse_a_(n_),
+        remainder_(2 * n_),
+        minus_(static_cast<std::size_t>(n_)),
+        batches_(grid_, fftw_threads) {
+    for (Index j = 0; j < n_; ++j) {
+      const Real k2 = grid_.laplacian_symbol()(j);
+      const Real root = std::sqrt(1.0 + eps * k2);
+      a_(j) = std::sqrt(root);
+      inverse_a_(j) = 1.0 / a_(j);
+      remainder_(j) = remainder_(n_ + j) = k2 / (1.0 + root);
+    }
+    for (const auto& [m, minus_m] : grid_.half_to_full()) {
+      minus_[static_cast<std::size_t>(m)] = minus_m;
+      minus_[static_cast<std::size_t>(minus_m)] = m;
+    }
+  }
+  using Model::linear_flow;
+  using Model::nonlinear_field;
+
+  Index dim() const override { return 2 * n_; }
+  bool is_complex() const override { return true; }
+  const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
+  const tsi::PhysicalVariables* physical_variables() const override { return this; }
+  const tsi::ExactNonlinearFlow* exact_nonlinear_flow() const override { return this; }
+  const tsi::SecondOrderForm* second_order_form() const override { return this; }
+  const tsi::RealVector& linear_remainder() const override { return remainder_; }
+
+  // e^{JM tau} = e^{i tau} on every coordinate.
+  void linear_flow(const tsi::RealVector& taus, MatrixRef c) const override {
+    for (Index j = 0; j < c.cols(); ++j) c.col(j) *= std::polar(Real(1), taus(j));
+  }
+
+  void nonlinear_field(ConstMatrixRef c, MatrixRef out) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (Index j = 0; j < c.cols(); ++j) {
+      const Vector z = field_z(c.col(j));
+      const Vector f = lambda_ * (z.array().abs2() * z.array()).matrix();
+      spectral_field(f, out.col(j));
+    }
+  }
+
+  // D(|z|^2 z) dz = 2 |z|^2 dz + z^2 conj(dz), dz = (du + conj dv) / 2.
+  void nonlinear_field_derivative(ConstMatrixRef c, ConstMatrixRef d, MatrixRef out) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (Index j = 0; j < c.cols(); ++j) {
+      const Vector z = field_z(c.col(j)), dz = field_z(d.col(j));
+      const Vector f =
+          lambda_ * (Real(2) * z.array().abs2() * dz.array() + z.array().square() * dz.array().conjugate()).matrix();
+      spectral_field(f, out.col(j));
+    }
+  }
+
+  // Along c' = f(c), z stays constant (dz = (i <D>^{-1} F + conj(i <D>^{-1} conj F)) / 2 = 0, <D>^{-1}
+  // being real and even), and so does f: the flow is c + t f(c).
+  void nonlinear_flow(Real t, Vector& c) const override {
+    const Vector field = nonlinear_field(c);
+    c += t * field;
+  }
+
+  void apply_M(const Vector& u, Vector& out) const override { out = u; }
+  void apply_J(const Vector& u, Vector& out) const override { out = Complex(0.0, 1.0) * u; }
+  Real H1(const Vector& c) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const Vector z = field_z(c);
+    return lambda_ / 2 * volume_ / point_count() * z.array().abs2().square().sum();
+  }
+
+  // Q = Im int conj(z) eps z_t = (2 pi)^d sum_k Im(conj(z_k) (eps z_t)_k) (Parseval), with the
+  // coefficients z_k = (u_k + conj(v_{-k})) / 2 and (eps z_t)_k = a_k^2 (conj(v_{-k}) - u_k) / (2 i).
+  Real charge(const Vector& c) const {
+    Real q = 0;
+    const Real scale = 1 / std::sqrt(volume_);
+    for (Index k = 0; k < n_; ++k) {
+      const Complex u = scale * inverse_a_(k) * c(k);
+      const Complex cv = std::conj(scale * inverse_a_(k) * c(n_ + minus_[static_cast<std::size_t>(k)]));
+      const Complex z = (u + cv) / Real(2), p = a_(k) * a_(k) * (cv - u) / Complex(0, 2);
+      q += (std::conj(z) * p).imag();
+    }
+    return volume_ * q;
+  }
+
+  std::vector<tsi::ModelInvariant> invariants() const override {
+    return {{"Q", "charge Im int conj(z) eps z_t dx: exact (the U(1) symmetry)",
+             [this](const Vector& c) { return charge(c); }}};
+  }
+
+  Vector initial_value() const override {
+    Vector uv(2 * n_);
+    Vector z(n_), p(n_);
+    grid_.for_each_point([&](Index j, const std::array<Real, 3>& x) {
+      Complex zz = 1, pp = 1;
+      for (int i = 0; i < grid_.dims(); ++i) {
+        const Real s = std::sin(x[static_cast<std::size_t>(i)]), co = std::cos(x[static_cast<std::size_t>(i)]);
+        if (data_ == Data::cos_sin) {
+          zz *= Complex(1, 1) * co;
+          pp *= Complex(1, -1) * s;
+        } else {
+          zz *= co;
+          pp *= s / 4 + co / 2;
+        }
+      }
+      z(j) = zz;
+      p(j) = pp;
+    });
+    // u = z - i <D>^{-1} p, v = conj z - i <D>^{-1} conj p.
+    std::lock_guard<std::mutex> lock(mutex_);
+    uv.head(n_) = z - Complex(0, 1) * inverse_D(p);
+    uv.tail(n_) = z.conjugate() - Complex(0, 1) * inverse_D(p.conjugate());
+    return from_samples(uv);
+  }
+
+  Index physical_dim() const override { return 2 * n_; }
+  std::vector<Index> physical_shape() const override {
+    std::vector<Index> shape{2};
+    for (const int n : grid_.shape()) shape.push_back(n);
+    return shape;
+  }
+  Vector from_physical(const Vector& uv) const override {
+    if (uv.size() != 2 * n_)
+      throw tsi::ConfigError("model.u0", "got " + std::to_string(uv.size()) + " samples, expected " +
+                                             std::to_string(2 * n_) + ": u, then v, on the grid " + grid_.describe());
+    std::lock_guard<std::mutex> lock(mutex_);
+    return from_samples(uv);
+  }
+  Vector to_physical(const Vector& c) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Vector uv(2 * n_);
+    tsi::GridTransforms& b = batches_.get(1);
+    for (int half = 0; half < 2; ++half) {
+      b.data().col(0) = inverse_a_.cwiseProduct(c.segment(half * n_, n_));
+      b.backward();
+      uv.segment(half * n_, n_) = b.data().col(0) / std::sqrt(volume_);
+    }
+    return uv;
+  }
+  Real error_norm(const Vector& uv) const override { return std::sqrt(volume_ / point_count()) * uv.norm(); }
+
+  // ---- The second-order form: z_k'' = -omega_k^2 z_k - (lambda / eps) (|z|^2 z)_k --------------
+  // omega_k = sqrt(1 + eps |k|^2) / eps, for the Fourier coefficients z_k = forward(z)_k / N; the
+  // positions are (Re z_k, Im z_k) (2N reals), the velocities those of (z_t)_k.
+  Index positions() const override { return 2 * n_; }
+  tsi::RealVector frequencies() const override {
+    tsi::RealVector omega(2 * n_);
+    for (Index j = 0; j < n_; ++j) omega(j) = omega(n_ + j) = a_(j) * a_(j) / eps();
+    return omega;
+  }
+  // z = (u + conj v) / 2 and eps z_t = <D> (conj v - u) / (2 i) on the grid.
+  void to_second_order(const Vector& c, tsi::RealVector& x, tsi::RealVector& v) const override {
+    const Vector uv = to_physical(c);
+    std::lock_guard<std::mutex> lock(mutex_);
+    const Vector u = uv.head(n_), conj_v = uv.tail(n_).conjugate();
+    tsi::GridTransforms& b = batches_.get(1);
+    b.data().col(0) = (u + conj_v) / Real(2);
+    b.forward();
+    const Vector z = b.data().col(0) / point_count();
+    b.data().col(0) = (conj_v - u) / Complex(0, 2);
+    b.forward();
+    const Vector p = a_.array().square().matrix().cwiseProduct(b.data().col(0)) / point_count();  // (eps z_t)_k
+    x.resize(2 * n_);
+    v.resize(2 * n_);
+    x << z.real(), z.imag();
+    v << p.real() / eps(), p.imag() / eps();
+  }
+  // u = z - i <D>^{-1} (eps z_t), v = conj z - i <D>^{-1} conj(eps z_t).
+  void from_second_order(const tsi::RealVector& x, const tsi::RealVector& v, Vector& c) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    tsi::GridTransforms& b = batches_.get(1);
+    b.data().col(0) = x.head(n_).cast<Complex>() + Complex(0, 1) * x.tail(n_).cast<Complex>();
+    b.backward();
+    const Vector z = b.data().col(0);
+    b.data().col(0) = eps() * (v.head(n_).cast<Complex>() + Complex(0, 1) * v.tail(n_).cast<Complex>());
+    b.backward();
+    const Vector p = b.data().col(0);
+    Vector uv(2 * n_);
+    uv.head(n_) = z - Complex(0, 1) * inverse_D(p);
+    uv.tail(n_) = z.conjugate() - Complex(0, 1) * inverse_D(p.conjugate());
+    c = from_samples(uv);
+  }
+  // g_k = -(lambda / eps) (|z|^2 z)_k, z = backward(z_k).
+  void force(const tsi::RealVector& x, tsi::RealVector& g) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    tsi::GridTransforms& b = batches_.get(1);
+    b.data().col(0) = x.head(n_).cast<Complex>() + Complex(0, 1) * x.tail(n_).cast<Complex>();
+    b.backward();
+    const Vector z = b.data().col(0);
+    b.data().col(0) = (-lambda_ / eps()) * (z.array().abs2() * z.array()).matrix();
+    b.forward();
+    g.resize(2 * n_);
+    g << b.data().col(0).real() / point_count(), b.data().col(0).imag() / point_count();
+  }
+
+ private:
+  Real point_count() const { return static_cast<Real>(n_); }
+
+  // c from the samples (u, v): c_u = (2 pi)^{d/2} / N a forward(u). Callers hold mutex_.
+  Vector from_samples(const Vector& uv) const {
+    Vector c(2 * n_);
+    tsi::GridTransforms& b = batches_.get(1);
+    for (int half = 0; half < 2; ++half) {
+      b.data().col(0) = uv.segment(half * n_, n_);
+      b.forward();
+      c.segment(half * n_, n_) = (std::sqrt(volume_) / point_count()) * a_.cwiseProduct(b.data().col(0));
+    }
+    return c;
+  }
+
+  // <D>^{-1} g on the grid. Callers hold mutex_.
+  Vector inverse_D(const Vector& g) const {
+    tsi::GridTransforms& b = batches_.get(1);
+    b.data().col(0) = g;
+    b.forward();
+    b.data().col(0) = inverse_a_.array().square().matrix().cwiseProduct(b.data().col(0)) / point_count();
+    b.backward();
+    return b.data().col(0);
+  }
+
+  // z = (u + conj v) / 2 on the grid, u = backward(a^{-1} c_u) / (2 pi)^{d/2}. Callers hold mutex_.
+  template <class Column>
+  Vector field_z(const Column& c) const {
+    tsi::GridTransforms& b = batches_.get(1);
+    b.data().col(0) = inverse_a_.cwiseProduct(c.head(n_));
+    b.backward();
+    Vector z = b.data().col(0);
+    b.data().col(0) = inverse_a_.cwiseProduct(c.tail(n_));
+    b.backward();
+    z = (z + b.data().col(0).conjugate()) / (2 * std::sqrt(volume_));
+    return z;
+  }
+
+  // out = i (2 pi)^{d/2} / N a^{-1} (forward(f), forward(conj f)). Callers hold mutex_.
+  template <class Column>
+  void spectral_field(const Vector& f, Column&& out) const {
+    tsi::GridTransforms& b = batches_.get(1);
+    const Complex scale(0, std::sqrt(volume_) / point_count());
+    b.data().col(0) = f;
+    b.forward();
+    out.head(n_) = scale * inverse_a_.cwiseProduct(b.data().col(0));
+    b.data().col(0) = f.conjugate();
+    b.forward();
+    out.tail(n_) = scale * inverse_a_.cwiseProduct(b.data().col(0));
+  }
+
+  tsi::SpectralGrid grid_;
+  Index n_;  // grid points, N
+  Real lambda_;
+  Data data_;
+  Real volume_;                // (2 pi)^d
+  tsi::RealVector a_;          // (1 + eps |k|^2)^{1/4}
+  tsi::RealVector inverse_a_;  // its inverse
+  tsi::RealVector remainder_;  // A_k on u's and on v's coefficients
+  std::vector<Index> minus_;   // the index of -k
+  mutable std::mutex mutex_;   // the transforms' buffers are shared work space
+  mutable tsi::GridTransformsPool batches_;
+};
+
+void register_klein_gordon_complex(tsi::Registry& registry) {
+  tsi::ModelEntry entry;
+  entry.info.name = "klein-gordon-complex";
+  entry.info.aliases = {"kg-complex"};
+  entry.info.summary =
+      "nonlinear Klein-Gordon with complex z, eps z_tt - lap z + z/eps + lambda |z|^2 z = 0 on the torus [0, 2 pi)^dims "
+      "(Chartier-Crouseilles-Lemou-Mehats), state (u, v) in Fourier, dim 2 n_x [n_y [n_z]]";
+  entry.info.params = tsi::spectral_grid_params("samples of u, then of v,");
+  entry.info.params.push_back(
+      tsi::string_param("data", "cos-sin",
+                        "initial data: \"cos-sin\" (z = (1+i) cos x, eps z_t = (1-i) sin x) or \"faou-schratz\" "
+                        "(z = cos x, eps z_t = sin(x)/4 + cos(x)/2); products over the directions in 2-D and 3-D")
+          .choices({"cos-sin", "faou-schratz"}));
+  entry.info.params.push_back(
+      tsi::number_param("lambda", 1.0, "coefficient of the cubic term lambda |z|^2 z")
+          .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number"));
+  entry.default_n_tau = 32;
+  entry.nonlinearity_degree = 3;
+  entry.linear_remainder = true;
+  entry.verification = {{1.0, 1.0 / 256, 1e-4, 1e-6}, {16, 32, 64, 128}};
+  entry.create = [](const tsi::Params& p) {
+    std::vector<int> shape = tsi::spectral_grid_shape(p);
+    const Data data = p.string("data") == "faou-schratz" ? Data::faou_schratz : Data::cos_sin;
+    return std::make_unique<KleinGordonComplex>(p.number("eps"), std::move(shape), p.number("lambda"), data,
+                                                p.context().fft);
+  };
+  registry.add_model(std::move(entry));
+}
+
+}  // namespace
+
+TSI_PLUGIN("klein-gordon-complex", register_klein_gordon_complex)
