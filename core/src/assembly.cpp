@@ -358,30 +358,26 @@ Assembly assemble(const ResolvedSelection& resolved, const Registry& registry, c
                       fmt::format("scheme \"{}\" needs a linear part diagonal in the problem's coordinates, which {} "
                                   "does not have; use a reformulation it supports ({})",
                                   a.scheme_entry->info.name, pair, fmt::join(traits.reformulations, ", ")));
+  // A capability the scheme uses and the problem lacks: named, with why it is missing.
+  const auto refuse = [&](const std::string& needs, const char* why) {
+    throw ConfigError("scheme.name", fmt::format("scheme \"{}\" needs {}, which {} does not provide{}",
+                                                 a.scheme_entry->info.name, needs, pair, why));
+  };
   if (traits.needs_exact_flows && !a.reformulation->has_exact_flows())
-    throw ConfigError("scheme.name",
-                      fmt::format("scheme \"{}\" needs the exact linear and nonlinear flows, which {} does not "
-                                  "provide{}",
-                                  a.scheme_entry->info.name, pair,
-                                  a.model->has_exact_nonlinear_flow()
-                                      ? " (only \"direct\" in model variables does)"
-                                      : " (the model has no exact nonlinear flow)"));
+    refuse("the exact linear and nonlinear flows", a.model->has_exact_nonlinear_flow()
+                                                       ? " (only \"direct\" in model variables does)"
+                                                       : " (the model has no exact nonlinear flow)");
   if (traits.needs_second_order_form && !a.reformulation->second_order())
-    throw ConfigError("scheme.name",
-                      fmt::format("scheme \"{}\" needs the second-order form x'' = -Omega^2 x + g(x), which {} does "
-                                  "not provide{}",
-                                  a.scheme_entry->info.name, pair,
-                                  a.model->has_second_order_form()
-                                      ? " (only \"direct\" does)"
-                                      : " (the model does not declare it; models that do: fput, henon-heiles, klein-gordon)"));
+    refuse("the second-order form x'' = -Omega^2 x + g(x)",
+           a.model->has_second_order_form()
+               ? " (only \"direct\" does)"
+               : " (the model does not declare it; models that do: fput, henon-heiles, klein-gordon, "
+                 "klein-gordon-complex)");
   if (traits.needs_charged_particle_form && !a.reformulation->charged_particle())
-    throw ConfigError("scheme.name",
-                      fmt::format("scheme \"{}\" needs the Lorentz-force form x' = v, v' = v x B(x) + E(x), which {} "
-                                  "does not provide{}",
-                                  a.scheme_entry->info.name, pair,
-                                  a.model->has_charged_particle_form()
-                                      ? " (only \"direct\" does)"
-                                      : " (the model does not declare it; models that do: cpd, charged-particle-3d)"));
+    refuse("the Lorentz-force form x' = v, v' = v x B(x) + E(x)",
+           a.model->has_charged_particle_form()
+               ? " (only \"direct\" does)"
+               : " (the model does not declare it; models that do: cpd, charged-particle-3d)");
   if (binds) a.bind(options.h);
   return a;
 }

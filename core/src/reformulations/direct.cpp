@@ -32,68 +32,71 @@ void require_linear_to_physical(const Model& model) {
 
 }  // namespace
 
-// The model's second-order form through the packing: the state unpacked into the model's d
-// values (a buffer of the run), then the model's own map; each force one evaluation of N.
-class Direct::SecondOrder final : public SecondOrderProblem {
+// A view of the state in the model's own variables for a declared form (second-order,
+// Lorentz force): the state unpacked into the model's d values (a buffer of the run) where the
+// packing is on, and a model state packed back into it; each evaluation of the form's field
+// counts as one of N.
+class Direct::FormView {
+ protected:
+  FormView(const Model& model, const RealPacking& packing, long& evaluations)
+      : packing_(packing), evaluations_(evaluations), values_(model.dim()) {}
+  // y as the model's values: y itself, or unpacked into the buffer.
+  const Vector& values_of(const Vector& y) {
+    if (!packing_.on()) return y;
+    packing_.unpack(y.data(), values_.data());
+    return values_;
+  }
+  // Where the model writes the values of a state for y: y itself, or the buffer, which
+  // store_into then packs into y.
+  Vector& values_for(Vector& y) { return packing_.on() ? values_ : y; }
+  void store_into(Vector& y) const {
+    if (packing_.on()) packing_.pack_into(values_.data(), y);
+  }
+  void count_evaluation() { ++evaluations_; }
+
+ private:
+  const RealPacking& packing_;
+  long& evaluations_;
+  Vector values_;
+};
+
+class Direct::SecondOrder final : public SecondOrderProblem, FormView {
  public:
   SecondOrder(const Model& model, const SecondOrderForm& form, const RealPacking& packing, long& evaluations)
-      : form_(form),
-        packing_(packing),
-        evaluations_(evaluations),
-        frequencies_(form.frequencies()),
-        values_(model.dim()) {}
+      : FormView(model, packing, evaluations), form_(form), frequencies_(form.frequencies()) {}
   Index positions() const override { return form_.positions(); }
   const RealVector& frequencies() const override { return frequencies_; }
-  void split(const Vector& y, RealVector& x, RealVector& v) override {
-    if (!packing_.on()) return form_.to_second_order(y, x, v);
-    packing_.unpack(y.data(), values_.data());
-    form_.to_second_order(values_, x, v);
-  }
+  void split(const Vector& y, RealVector& x, RealVector& v) override { form_.to_second_order(values_of(y), x, v); }
   void join(const RealVector& x, const RealVector& v, Vector& y) override {
-    if (!packing_.on()) return form_.from_second_order(x, v, y);
-    form_.from_second_order(x, v, values_);
-    y.resize(packing_.size());
-    packing_.pack(values_.data(), y.data());
+    form_.from_second_order(x, v, values_for(y));
+    store_into(y);
   }
   void force(const RealVector& x, RealVector& g) override {
-    ++evaluations_;
+    count_evaluation();
     form_.force(x, g);
   }
 
  private:
   const SecondOrderForm& form_;
-  const RealPacking& packing_;
-  long& evaluations_;
   RealVector frequencies_;
-  Vector values_;
 };
 
-// The model's Lorentz-force form through the packing, as the second-order form above.
-class Direct::ChargedParticle final : public ChargedParticleProblem {
+class Direct::ChargedParticle final : public ChargedParticleProblem, FormView {
  public:
   ChargedParticle(const Model& model, const ChargedParticleForm& form, const RealPacking& packing, long& evaluations)
-      : form_(form), packing_(packing), evaluations_(evaluations), values_(model.dim()) {}
-  void split(const Vector& y, RealVector3& x, RealVector3& v) override {
-    if (!packing_.on()) return form_.to_particle(y, x, v);
-    packing_.unpack(y.data(), values_.data());
-    form_.to_particle(values_, x, v);
-  }
+      : FormView(model, packing, evaluations), form_(form) {}
+  void split(const Vector& y, RealVector3& x, RealVector3& v) override { form_.to_particle(values_of(y), x, v); }
   void join(const RealVector3& x, const RealVector3& v, Vector& y) override {
-    if (!packing_.on()) return form_.from_particle(x, v, y);
-    form_.from_particle(x, v, values_);
-    y.resize(packing_.size());
-    packing_.pack(values_.data(), y.data());
+    form_.from_particle(x, v, values_for(y));
+    store_into(y);
   }
   void fields(const RealVector3& x, RealVector3& B, RealVector3& E) override {
-    ++evaluations_;
+    count_evaluation();
     form_.fields(x, B, E);
   }
 
  private:
   const ChargedParticleForm& form_;
-  const RealPacking& packing_;
-  long& evaluations_;
-  Vector values_;
 };
 
 Direct::Direct(std::shared_ptr<const Model> model, Variables variables, bool real_layout)

@@ -69,6 +69,7 @@ class Direct final : public Reformulation {
   Vector remainder_;  // i omega per coordinate (empty without a remainder)
   RealPacking packing_;
   Vector x_, result_;  // the state and N as d values, where the packing is on
+  class FormView;  // a declared form's view of the state (direct.cpp)
   class SecondOrder;
   std::unique_ptr<SecondOrderProblem> second_order_;  // where the model declares the form
   class ChargedParticle;

@@ -44,6 +44,7 @@ namespace {
 using tsi::Complex;
 using tsi::ConstMatrixRef;
 using tsi::Index;
+using tsi::Matrix;
 using tsi::MatrixRef;
 using tsi::Real;
 using tsi::Vector;
@@ -96,24 +97,19 @@ class KleinGordonComplex final : public tsi::Model,
     for (Index j = 0; j < c.cols(); ++j) c.col(j) *= std::polar(Real(1), taus(j));
   }
 
+  // Every column (a tau grid's states) in one batch of transforms.
   void nonlinear_field(ConstMatrixRef c, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (Index j = 0; j < c.cols(); ++j) {
-      const Vector z = field_z(c.col(j));
-      const Vector f = lambda_ * (z.array().abs2() * z.array()).matrix();
-      spectral_field(f, out.col(j));
-    }
+    const Matrix z = field_z(c);
+    spectral_field(lambda_ * (z.array().abs2() * z.array()).matrix(), out);
   }
 
   // D(|z|^2 z) dz = 2 |z|^2 dz + z^2 conj(dz), dz = (du + conj dv) / 2.
   void nonlinear_field_derivative(ConstMatrixRef c, ConstMatrixRef d, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (Index j = 0; j < c.cols(); ++j) {
-      const Vector z = field_z(c.col(j)), dz = field_z(d.col(j));
-      const Vector f =
-          lambda_ * (Real(2) * z.array().abs2() * dz.array() + z.array().square() * dz.array().conjugate()).matrix();
-      spectral_field(f, out.col(j));
-    }
+    const Matrix z = field_z(c), dz = field_z(d);
+    spectral_field(
+        lambda_ * (Real(2) * z.array().abs2() * dz.array() + z.array().square() * dz.array().conjugate()).matrix(), out);
   }
 
   // Along c' = f(c), z stays constant (dz = (i <D>^{-1} F + conj(i <D>^{-1} conj F)) / 2 = 0, <D>^{-1}
@@ -127,7 +123,7 @@ class KleinGordonComplex final : public tsi::Model,
   void apply_J(const Vector& u, Vector& out) const override { out = Complex(0.0, 1.0) * u; }
   Real H1(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    const Vector z = field_z(c);
+    const Matrix z = field_z(c);
     return lambda_ / 2 * volume_ / point_count() * z.array().abs2().square().sum();
   }
 
@@ -280,30 +276,30 @@ class KleinGordonComplex final : public tsi::Model,
     return b.data().col(0);
   }
 
-  // z = (u + conj v) / 2 on the grid, u = backward(a^{-1} c_u) / (2 pi)^{d/2}. Callers hold mutex_.
-  template <class Column>
-  Vector field_z(const Column& c) const {
-    tsi::GridTransforms& b = batches_.get(1);
-    b.data().col(0) = inverse_a_.cwiseProduct(c.head(n_));
+  // z = (u + conj v) / 2 on the grid for every column, u = backward(a^{-1} c_u) / (2 pi)^{d/2}.
+  // Callers hold mutex_.
+  Matrix field_z(ConstMatrixRef c) const {
+    tsi::GridTransforms& b = batches_.get(c.cols());
+    b.data() = inverse_a_.asDiagonal() * c.topRows(n_);
     b.backward();
-    Vector z = b.data().col(0);
-    b.data().col(0) = inverse_a_.cwiseProduct(c.tail(n_));
+    Matrix z = b.data();
+    b.data() = inverse_a_.asDiagonal() * c.bottomRows(n_);
     b.backward();
-    z = (z + b.data().col(0).conjugate()) / (2 * std::sqrt(volume_));
+    z = (z + b.data().conjugate()) / (2 * std::sqrt(volume_));
     return z;
   }
 
-  // out = i (2 pi)^{d/2} / N a^{-1} (forward(f), forward(conj f)). Callers hold mutex_.
-  template <class Column>
-  void spectral_field(const Vector& f, Column&& out) const {
-    tsi::GridTransforms& b = batches_.get(1);
+  // out = i (2 pi)^{d/2} / N a^{-1} (forward(f), forward(conj f)), column by column. Callers hold
+  // mutex_.
+  void spectral_field(const Matrix& f, MatrixRef out) const {
+    tsi::GridTransforms& b = batches_.get(f.cols());
     const Complex scale(0, std::sqrt(volume_) / point_count());
-    b.data().col(0) = f;
+    b.data() = f;
     b.forward();
-    out.head(n_) = scale * inverse_a_.cwiseProduct(b.data().col(0));
-    b.data().col(0) = f.conjugate();
+    out.topRows(n_) = scale * (inverse_a_.asDiagonal() * b.data());
+    b.data() = f.conjugate();
     b.forward();
-    out.tail(n_) = scale * inverse_a_.cwiseProduct(b.data().col(0));
+    out.bottomRows(n_) = scale * (inverse_a_.asDiagonal() * b.data());
   }
 
   tsi::SpectralGrid grid_;

@@ -146,7 +146,7 @@ class Boris final : public tsi::Stepper {
       RealVector3 Ebar;
       form_.fields(evaluation_point(x, v, B, f), Bbar, Ebar);
     }
-    const Filters fbar = filters(Bbar);
+    const Filters fbar = settings_.explicit_point ? f : filters(Bbar);
     const RealVector3 w = v + h_ * apply(B, 0, 0, f.ups_im, E);
     // phi1(-z) at z = i y: sinc(y) - i (1 - cos y) / y.
     const Real yb = fbar.y;
@@ -178,7 +178,7 @@ class Boris final : public tsi::Stepper {
         RealVector3 Ebar;
         form_.fields(evaluation_point(x, v, B, f), Bbar, Ebar);
       }
-      const Filters fbar = filters(Bbar);
+      const Filters fbar = pass == 0 ? f : filters(Bbar);  // the first pass turns about B itself
       // exp(-h Bbar^) v_+: the normal part turned by -y about Bbar.
       minus = apply(Bbar, 1, std::cos(fbar.y), -std::sin(fbar.y), plus);
       v = apply(Bbar, 1, fbar.inv_sinc, 0, (minus + plus) / 2) - drift;

@@ -110,7 +110,7 @@ tsi::SecondOrderProblem& second_order_of(tsi::Problem& problem) {
   if (!form)
     throw tsi::ConfigError("scheme.name", "got \"trigonometric\" on a problem without the second-order form "
                                           "x'' = -Omega^2 x + g(x); expected the direct reformulation of a model that "
-                                          "declares it (fput, henon-heiles, klein-gordon)");
+                                          "declares it (fput, henon-heiles, klein-gordon, klein-gordon-complex)");
   return *form;
 }
 
