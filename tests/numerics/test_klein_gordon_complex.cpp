@@ -7,48 +7,30 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <fstream>
 #include <string>
 #include <vector>
 
 #include "harness.hpp"
+#include "micromacro_reference.hpp"
 #include "tsi/convergence.hpp"
 
 namespace {
 
-using tsi::Complex;
 using tsi::Json;
 using tsi::Vector;
 using tsi::test::Harness;
-
-// (u, v) on the 128-point grid from a reference file: one line per point, Re u, Im u, Re v, Im v.
-Vector micromacro_reference(const std::string& name) {
-  std::ifstream in(std::string(TSI_TEST_SOURCE_DIR) + "/tests/data/rivals/micromacro-cos-sin/donnee_" + name + ".txt");
-  REQUIRE(in);
-  Vector uv(256);
-  for (int j = 0; j < 128; ++j) {
-    double ur, ui, vr, vi;
-    in >> ur >> ui >> vr >> vi;
-    REQUIRE(static_cast<bool>(in));
-    uv(j) = Complex(ur, ui);
-    uv(128 + j) = Complex(vr, vi);
-  }
-  return uv;
-}
 
 }  // namespace
 
 TEST_CASE("klein-gordon-complex: CosSin at T = 0.25 is MicroMacro.jl's reference solution for eps = 1 .. 1e-6") {
   // eab of order 4 on the two-scale problem at h = 1/256: uniformly accurate, so one step size serves
   // every eps; rk78 on the filtered problem (tol 1e-13) as a second route where its cost allows.
-  const std::vector<std::pair<double, std::string>> cases = {{1.0, "1"},       {0.1, "0_1"},      {0.01, "0_01"},
-                                                             {1e-3, "0_001"},  {1e-4, "0_0001"},  {1e-5, "0_00001"},
-                                                             {1e-6, "0_000001"}};
+  const auto& cases = tsi::test::micromacro_cases();
   auto& harness = Harness::instance();
   for (const auto& c : cases) {
     const double eps = c.first;
     auto model = harness.model_with("klein-gordon-complex", eps, {{"n_x", 128}});
-    const Vector reference = micromacro_reference(c.second);
+    const Vector reference = tsi::test::micromacro_reference(c.second);
     const double norm = model->error_norm(reference);
     auto two_scale = harness.reformulation("two-scale", model, {{"n_tau", 32}, {"initial_data_order", 6}});
     const Vector eab = tsi::test::solve(*model, *two_scale, *harness.scheme("eab", {{"order", 4}}), 0.25, 64);

@@ -84,6 +84,11 @@ class TSI_API Problem {
   /// 2 pi eps / Model::max_linear_frequency()), 0 if none.
   /// Adaptive solvers must not step across it: their error estimates alias.
   virtual Real fast_period() const { return 0.0; }
+  /// The period in t of the whole explicit time dependence when the problem is the filtered
+  /// one, N(t, y) = f_{t/eps}(y): 2 pi eps (e^{A tau} is 2 pi-periodic), 0 otherwise. The
+  /// micro-macro and nested Picard schemes evaluate f_tau(y) = N(eps tau, y) on their own tau
+  /// grid through it.
+  virtual Real oscillation_period() const { return 0.0; }
 
   /// out = N(t, y).
   virtual void nonlinear(Real t, const Vector& y, Vector& out) = 0;

@@ -22,6 +22,8 @@ class Filtered final : public Reformulation {
   /// The shortest period of the explicit time dependence: 2 pi eps over the model's
   /// largest linear frequency (2 pi eps for Henon-Heiles; 2 pi eps / 64 for NLS with N_x = 16).
   Real fast_period() const override { return two_pi * model_->eps() / model_->max_linear_frequency(); }
+  /// 2 pi eps: N(t, y) = f_{t/eps}(y) has this period in t.
+  Real oscillation_period() const override { return two_pi * model_->eps(); }
   void nonlinear(Real t, const Vector& y, Vector& out) override;
   void nonlinear_derivative(Real t, const Vector& y, const Vector& dy, Vector& out) override;
   void rhs(Real t, const Vector& y, Vector& out) override;
