@@ -428,7 +428,8 @@ std::string study_text(const Study& study, const Json& rows) {
       std::string name = first["label"].get<std::string>().empty() ? first["scheme"].get<std::string>()
                                                                    : first["label"].get<std::string>();
       if (!first["varied"].empty()) name = fmt::format("{} {}", name, first["varied"].dump());
-      if (n_taus.size() > 1) name = fmt::format("{} (n_tau {})", name, first["n_tau"].dump());
+      // (a filtered or direct series has no tau grid of the reformulation: nothing to say)
+      if (n_taus.size() > 1 && !first["n_tau"].is_null()) name = fmt::format("{} (n_tau {})", name, first["n_tau"].dump());
       s += fmt::format("\n{} on {}: relative error at t = {:g} (observed order)\n", name,
                        first["model"].get<std::string>(), first["t_end"].get<double>());
       s += fmt::format("  {:>8}", "h");
