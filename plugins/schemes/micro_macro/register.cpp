@@ -96,13 +96,25 @@ void register_micro_macro(tsi::Registry& registry) {
   npi.info.name = "npi";
   npi.info.aliases = {"nested-picard"};
   npi.info.summary =
-      "nested Picard of order 1 (Cai-Zhou) on the filtered problem: the field frozen at y_n, its fast phase "
-      "integrated exactly (uniform order 1)";
-  npi.info.params = {n_tau_param("it must resolve the tau spectrum of f_tau")};
+      "nested Picard (after Cai-Zhou) on the filtered problem: Picard iterates of Duhamel's formula with the "
+      "fast phase integrated exactly, uniform order 1 or 2";
+  npi.info.params = {
+      tsi::integer_param("order", 1,
+                         "1: the field frozen at y_n; 2: the second Picard iterate linearised about y_n (two "
+                         "batches of Df more)")
+          .range(1, 2),
+      n_tau_param("it must resolve the tau spectrum of f_tau"),
+  };
   npi.traits.order = 1;
   npi.traits.reformulations = {"filtered"};
+  npi.traits_for = [base = npi.traits](const tsi::Json& params) {
+    tsi::StepperTraits traits = base;
+    traits.order = params.value("order", 1);
+    return traits;
+  };
   npi.create = [](const tsi::Params& p) {
-    return tsi::make_scheme<NestedPicard>(NestedPicardSettings{static_cast<int>(p.integer("n_tau"))});
+    return tsi::make_scheme<NestedPicard>(
+        NestedPicardSettings{static_cast<int>(p.integer("n_tau")), static_cast<int>(p.integer("order"))});
   };
   registry.add_scheme(std::move(npi));
 }

@@ -56,6 +56,38 @@ class TauSeries {
       out += coefficients_.col(j) * (Complex(std::cos(phase), std::sin(phase)) / Complex(0, static_cast<Real>(k)));
     }
   }
+  /// (A^2 g)(theta), the antiderivative taken twice (mode k divided by (ik)^2).
+  void second_antiderivative_at(Real theta, Vector& out) const {
+    out.setZero(coefficients_.rows());
+    for (int j = 1; j < n_tau_; ++j) {
+      const int k = wave_number(j);
+      if (k == 0) continue;
+      const Real phase = static_cast<Real>(k) * theta;
+      out -= coefficients_.col(j) * (Complex(std::cos(phase), std::sin(phase)) / static_cast<Real>(k * k));
+    }
+  }
+  /// int_0^h g(theta(s)) ds with theta(s) = theta_0 + s / eps, exactly:
+  /// h <g> + eps [(A g)(theta_1) - (A g)(theta_0)] (theta_1 = theta(h)).
+  void integral(Real h, Real eps, Real theta0, Real theta1, Vector& out, Vector& work) const {
+    mean(out);
+    out *= h;
+    antiderivative_at(theta1, work);
+    out += eps * work;
+    antiderivative_at(theta0, work);
+    out -= eps * work;
+  }
+  /// int_0^h s g(theta(s)) ds, exactly (by parts):
+  /// h^2/2 <g> + eps h (A g)(theta_1) - eps^2 [(A^2 g)(theta_1) - (A^2 g)(theta_0)].
+  void moment(Real h, Real eps, Real theta0, Real theta1, Vector& out, Vector& work) const {
+    mean(out);
+    out *= h * h / 2;
+    antiderivative_at(theta1, work);
+    out += (eps * h) * work;
+    second_antiderivative_at(theta1, work);
+    out -= (eps * eps) * work;
+    second_antiderivative_at(theta0, work);
+    out += (eps * eps) * work;
+  }
   /// g(theta), the trigonometric interpolant of the grid values.
   void value_at(Real theta, Vector& out) const {
     out = coefficients_.col(0);
