@@ -96,13 +96,13 @@ void register_micro_macro(tsi::Registry& registry) {
   npi.info.name = "npi";
   npi.info.aliases = {"nested-picard"};
   npi.info.summary =
-      "nested Picard (after Cai-Zhou) on the filtered problem: Picard iterates of Duhamel's formula with the "
-      "fast phase integrated exactly, uniform order 1 or 2";
+      "nested Picard (after Cai-Zhou) on the filtered problem: m Picard iterates of Duhamel's formula, "
+      "polynomial in the slow time, the fast phase integrated exactly; uniform order m = 1 .. 4, only f";
   npi.info.params = {
       tsi::integer_param("order", 1,
-                         "1: the field frozen at y_n; 2: the second Picard iterate linearised about y_n (two "
-                         "batches of Df more)")
-          .range(1, 2),
+                         "m, the Picard iterates (uniform order m; m (m + 1)/2 batches of n_tau evaluations of f "
+                         "a step; 1: the field frozen at y_n)")
+          .range(1, 4),
       n_tau_param("it must resolve the tau spectrum of f_tau"),
   };
   npi.traits.order = 1;

@@ -56,6 +56,29 @@ class TauSeries {
       out += coefficients_.col(j) * (Complex(std::cos(phase), std::sin(phase)) / Complex(0, static_cast<Real>(k)));
     }
   }
+  /// (A^power g)(tau_j) at every grid point, scaled by `scale` (mode k divided by (ik)^power).
+  void antiderivative_power_grid(int power, Matrix& out, Real scale = 1) {
+    work_.col(0).setZero();
+    for (int j = 1; j < n_tau_; ++j) {
+      const int k = wave_number(j);
+      if (k == 0)
+        work_.col(j).setZero();
+      else
+        work_.col(j) = coefficients_.col(j) * (scale / std::pow(Complex(0, static_cast<Real>(k)), power));
+    }
+    out.resize(coefficients_.rows(), n_tau_);
+    fft_.transform(work_.data(), out.data(), 1);
+  }
+  /// (A^power g)(theta) at any phase.
+  void antiderivative_power_at(int power, Real theta, Vector& out) const {
+    out.setZero(coefficients_.rows());
+    for (int j = 1; j < n_tau_; ++j) {
+      const int k = wave_number(j);
+      if (k == 0) continue;
+      const Real phase = static_cast<Real>(k) * theta;
+      out += coefficients_.col(j) * (Complex(std::cos(phase), std::sin(phase)) / std::pow(Complex(0, static_cast<Real>(k)), power));
+    }
+  }
   /// (A^2 g)(theta), the antiderivative taken twice (mode k divided by (ik)^2).
   void second_antiderivative_at(Real theta, Vector& out) const {
     out.setZero(coefficients_.rows());
