@@ -59,15 +59,6 @@ class FilteredGrid {
       out.col(j) = result_;
     }
   }
-  /// out.col(j) = Df_{tau_j}(y) zs.col(j): a direction per grid point.
-  void derivative(const Vector& y, const Matrix& zs, Matrix& out) {
-    out.resize(rows(), n_tau_);
-    for (int j = 0; j < n_tau_; ++j) {
-      column_ = zs.col(j);
-      problem_.nonlinear_derivative(times_[static_cast<size_t>(j)], y, column_, result_);
-      out.col(j) = result_;
-    }
-  }
   /// f_theta(y) at the time t itself (theta = t / eps).
   void field_at(Real t, const Vector& y, Vector& out) {
     out.resize(rows());

@@ -26,6 +26,13 @@ class TauSeries {
   /// The wave number of coefficient column j (FFT order), 0 for the Nyquist column (dropped).
   int wave_number(int j) const { return j < n_tau_ / 2 ? j : (j == n_tau_ / 2 ? 0 : j - n_tau_); }
 
+  /// (i k)^power, by products (exact for the integers here).
+  static Complex ik_power(int k, int power) {
+    Complex z(1, 0);
+    for (int i = 0; i < power; ++i) z *= Complex(0, static_cast<Real>(k));
+    return z;
+  }
+
   /// Takes g's values on the grid (rows x n_tau).
   void analyse(const Matrix& values) {
     fft_.transform(values.data(), coefficients_.data(), 0, Real(1) / static_cast<Real>(n_tau_));
@@ -33,29 +40,6 @@ class TauSeries {
   }
   /// <g>, the mean over tau.
   void mean(Vector& out) const { out = coefficients_.col(0); }
-  /// (A g)(tau_j) at every grid point, scaled by `scale`.
-  void antiderivative_grid(Matrix& out, Real scale = 1) {
-    work_.col(0).setZero();
-    for (int j = 1; j < n_tau_; ++j) {
-      const int k = wave_number(j);
-      if (k == 0)
-        work_.col(j).setZero();
-      else
-        work_.col(j) = coefficients_.col(j) * (scale / Complex(0, static_cast<Real>(k)));
-    }
-    out.resize(coefficients_.rows(), n_tau_);
-    fft_.transform(work_.data(), out.data(), 1);
-  }
-  /// (A g)(theta) at any phase.
-  void antiderivative_at(Real theta, Vector& out) const {
-    out.setZero(coefficients_.rows());
-    for (int j = 1; j < n_tau_; ++j) {
-      const int k = wave_number(j);
-      if (k == 0) continue;
-      const Real phase = static_cast<Real>(k) * theta;
-      out += coefficients_.col(j) * (Complex(std::cos(phase), std::sin(phase)) / Complex(0, static_cast<Real>(k)));
-    }
-  }
   /// (A^power g)(tau_j) at every grid point, scaled by `scale` (mode k divided by (ik)^power).
   void antiderivative_power_grid(int power, Matrix& out, Real scale = 1) {
     work_.col(0).setZero();
@@ -64,7 +48,7 @@ class TauSeries {
       if (k == 0)
         work_.col(j).setZero();
       else
-        work_.col(j) = coefficients_.col(j) * (scale / std::pow(Complex(0, static_cast<Real>(k)), power));
+        work_.col(j) = coefficients_.col(j) * (scale / ik_power(k, power));
     }
     out.resize(coefficients_.rows(), n_tau_);
     fft_.transform(work_.data(), out.data(), 1);
@@ -76,41 +60,13 @@ class TauSeries {
       const int k = wave_number(j);
       if (k == 0) continue;
       const Real phase = static_cast<Real>(k) * theta;
-      out += coefficients_.col(j) * (Complex(std::cos(phase), std::sin(phase)) / std::pow(Complex(0, static_cast<Real>(k)), power));
+      out += coefficients_.col(j) * (Complex(std::cos(phase), std::sin(phase)) / ik_power(k, power));
     }
   }
-  /// (A^2 g)(theta), the antiderivative taken twice (mode k divided by (ik)^2).
-  void second_antiderivative_at(Real theta, Vector& out) const {
-    out.setZero(coefficients_.rows());
-    for (int j = 1; j < n_tau_; ++j) {
-      const int k = wave_number(j);
-      if (k == 0) continue;
-      const Real phase = static_cast<Real>(k) * theta;
-      out -= coefficients_.col(j) * (Complex(std::cos(phase), std::sin(phase)) / static_cast<Real>(k * k));
-    }
-  }
-  /// int_0^h g(theta(s)) ds with theta(s) = theta_0 + s / eps, exactly:
-  /// h <g> + eps [(A g)(theta_1) - (A g)(theta_0)] (theta_1 = theta(h)).
-  void integral(Real h, Real eps, Real theta0, Real theta1, Vector& out, Vector& work) const {
-    mean(out);
-    out *= h;
-    antiderivative_at(theta1, work);
-    out += eps * work;
-    antiderivative_at(theta0, work);
-    out -= eps * work;
-  }
-  /// int_0^h s g(theta(s)) ds, exactly (by parts):
-  /// h^2/2 <g> + eps h (A g)(theta_1) - eps^2 [(A^2 g)(theta_1) - (A^2 g)(theta_0)].
-  void moment(Real h, Real eps, Real theta0, Real theta1, Vector& out, Vector& work) const {
-    mean(out);
-    out *= h * h / 2;
-    antiderivative_at(theta1, work);
-    out += (eps * h) * work;
-    second_antiderivative_at(theta1, work);
-    out -= (eps * eps) * work;
-    second_antiderivative_at(theta0, work);
-    out += (eps * eps) * work;
-  }
+  /// (A g)(tau_j) at every grid point, scaled by `scale`.
+  void antiderivative_grid(Matrix& out, Real scale = 1) { antiderivative_power_grid(1, out, scale); }
+  /// (A g)(theta) at any phase.
+  void antiderivative_at(Real theta, Vector& out) const { antiderivative_power_at(1, theta, out); }
   /// g(theta), the trigonometric interpolant of the grid values.
   void value_at(Real theta, Vector& out) const {
     out = coefficients_.col(0);
