@@ -27,6 +27,8 @@
 //                  with its reference solutions at T = 0.25, N = 128: tests/data/rivals/)
 //   faou-schratz   z(0) = cos x, eps z_t(0) = sin(x) / 4 + cos(x) / 2 (Faou and Schratz's 6.3,
 //                  MicroMacro.jl's data set 2)
+//   cai-zhou       z(0) = (2 + i)/sqrt(5) cos x, eps z_t(0) = (1 + i)/sqrt(2) sin x + cos(x) / 2 (Cai
+//                  and Zhou's (6.2), their code's data set 2; their psi_t(0) = psi1/e^2 with e^2 = eps)
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -49,7 +51,7 @@ using tsi::MatrixRef;
 using tsi::Real;
 using tsi::Vector;
 
-enum class Data { cos_sin, faou_schratz };
+enum class Data { cos_sin, faou_schratz, cai_zhou };
 
 class KleinGordonComplex final : public tsi::Model,
                                  public tsi::HamiltonianStructure,
@@ -156,6 +158,9 @@ class KleinGordonComplex final : public tsi::Model,
         if (data_ == Data::cos_sin) {
           zz *= Complex(1, 1) * co;
           pp *= Complex(1, -1) * s;
+        } else if (data_ == Data::cai_zhou) {
+          zz *= Complex(2, 1) / std::sqrt(Real(5)) * co;
+          pp *= Complex(1, 1) / std::sqrt(Real(2)) * s + co / 2;
         } else {
           zz *= co;
           pp *= s / 4 + co / 2;
@@ -325,9 +330,10 @@ void register_klein_gordon_complex(tsi::Registry& registry) {
   entry.info.params = tsi::spectral_grid_params("samples of u, then of v,");
   entry.info.params.push_back(
       tsi::string_param("data", "cos-sin",
-                        "initial data: \"cos-sin\" (z = (1+i) cos x, eps z_t = (1-i) sin x) or \"faou-schratz\" "
-                        "(z = cos x, eps z_t = sin(x)/4 + cos(x)/2); products over the directions in 2-D and 3-D")
-          .choices({"cos-sin", "faou-schratz"}));
+                        "initial data: \"cos-sin\" (z = (1+i) cos x, eps z_t = (1-i) sin x), \"faou-schratz\" "
+                        "(z = cos x, eps z_t = sin(x)/4 + cos(x)/2) or \"cai-zhou\" (z = (2+i)/sqrt5 cos x, eps z_t = "
+                        "(1+i)/sqrt2 sin x + cos(x)/2); products over the directions in 2-D and 3-D")
+          .choices({"cos-sin", "faou-schratz", "cai-zhou"}));
   entry.info.params.push_back(
       tsi::number_param("lambda", 1.0, "coefficient of the cubic term lambda |z|^2 z")
           .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number"));
@@ -337,7 +343,8 @@ void register_klein_gordon_complex(tsi::Registry& registry) {
   entry.verification = {{1.0, 1.0 / 256, 1e-4, 1e-6}, {16, 32, 64, 128}};
   entry.create = [](const tsi::Params& p) {
     std::vector<int> shape = tsi::spectral_grid_shape(p);
-    const Data data = p.string("data") == "faou-schratz" ? Data::faou_schratz : Data::cos_sin;
+    const std::string name = p.string("data");
+    const Data data = name == "faou-schratz" ? Data::faou_schratz : name == "cai-zhou" ? Data::cai_zhou : Data::cos_sin;
     return std::make_unique<KleinGordonComplex>(p.number("eps"), std::move(shape), p.number("lambda"), data,
                                                 p.context().fft);
   };
