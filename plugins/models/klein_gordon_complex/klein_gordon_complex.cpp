@@ -28,7 +28,8 @@
 //   faou-schratz   z(0) = cos x, eps z_t(0) = sin(x) / 4 + cos(x) / 2 (Faou and Schratz's 6.3,
 //                  MicroMacro.jl's data set 2)
 //   cai-zhou       z(0) = (2 + i)/sqrt(5) cos x, eps z_t(0) = (1 + i)/sqrt(2) sin x + cos(x) / 2 (Cai
-//                  and Zhou's (6.2), their code's data set 2; their psi_t(0) = psi1/e^2 with e^2 = eps)
+//                  and Zhou's (6.2), their code's data set 2, their psi_t(0) = psi1/e^2 with e^2 = eps;
+//                  Faou and Schratz's 6.2, which MicroMacro.jl's data set 2 defines and then overwrites)
 #include <cmath>
 #include <memory>
 #include <mutex>
