@@ -30,6 +30,11 @@
 //   cai-zhou       z(0) = (2 + i)/sqrt(5) cos x, eps z_t(0) = (1 + i)/sqrt(2) sin x + cos(x) / 2 (Cai
 //                  and Zhou's (6.2), their code's data set 2, their psi_t(0) = psi1/e^2 with e^2 = eps;
 //                  Faou and Schratz's 6.2, which MicroMacro.jl's data set 2 defines and then overwrites)
+//   bao-dong       z(0) = 2 / (e^{x^2} + e^{-x^2}) = sech(x^2), eps z_t(0) = 0, x centred in the box
+//                  (Bao and Dong's; MicroMacro.jl's data set 1, with its llambda = -4, i.e. lambda = 4
+//                  here). It needs a box larger than 2 pi: `length` L, the box [-L/2, L/2) per direction.
+// `length` L (default 2 pi): the torus's period in each direction; the wave numbers are 2 pi k / L,
+// and every integral carries the volume L^dims.
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -52,7 +57,7 @@ using tsi::MatrixRef;
 using tsi::Real;
 using tsi::Vector;
 
-enum class Data { cos_sin, faou_schratz, cai_zhou };
+enum class Data { cos_sin, faou_schratz, cai_zhou, bao_dong };
 
 class KleinGordonComplex final : public tsi::Model,
                                  public tsi::HamiltonianStructure,
@@ -60,20 +65,22 @@ class KleinGordonComplex final : public tsi::Model,
                                  public tsi::PhysicalVariables,
                                  public tsi::SecondOrderForm {
  public:
-  KleinGordonComplex(Real eps, std::vector<int> shape, Real lambda, Data data, tsi::ThreadLimit fftw_threads)
+  KleinGordonComplex(Real eps, std::vector<int> shape, Real lambda, Data data, Real length,
+                     tsi::ThreadLimit fftw_threads)
       : Model(eps),
         grid_(std::move(shape)),
         n_(grid_.points()),
         lambda_(lambda),
         data_(data),
-        volume_(std::pow(tsi::two_pi, grid_.dims())),
+        length_(length),
+        volume_(std::pow(length, grid_.dims())),
         a_(n_),
         inverse_a_(n_),
         remainder_(2 * n_),
         minus_(static_cast<std::size_t>(n_)),
         batches_(grid_, fftw_threads) {
     for (Index j = 0; j < n_; ++j) {
-      const Real k2 = grid_.laplacian_symbol()(j);
+      const Real k2 = grid_.laplacian_symbol()(j) * std::pow(tsi::two_pi / length_, 2);  // (2 pi k / L)^2
       const Real root = std::sqrt(1.0 + eps * k2);
       a_(j) = std::sqrt(root);
       inverse_a_(j) = 1.0 / a_(j);
@@ -155,8 +162,13 @@ class KleinGordonComplex final : public tsi::Model,
     grid_.for_each_point([&](Index j, const std::array<Real, 3>& x) {
       Complex zz = 1, pp = 1;
       for (int i = 0; i < grid_.dims(); ++i) {
-        const Real s = std::sin(x[static_cast<std::size_t>(i)]), co = std::cos(x[static_cast<std::size_t>(i)]);
-        if (data_ == Data::cos_sin) {
+        const Real xi = x[static_cast<std::size_t>(i)] * (length_ / tsi::two_pi);  // in [0, L)
+        const Real s = std::sin(xi), co = std::cos(xi);
+        if (data_ == Data::bao_dong) {
+          const Real c = xi - length_ / 2;  // centred
+          zz *= 2 / (std::exp(c * c) + std::exp(-c * c));
+          pp = 0;
+        } else if (data_ == Data::cos_sin) {
           zz *= Complex(1, 1) * co;
           pp *= Complex(1, -1) * s;
         } else if (data_ == Data::cai_zhou) {
@@ -312,7 +324,8 @@ class KleinGordonComplex final : public tsi::Model,
   Index n_;  // grid points, N
   Real lambda_;
   Data data_;
-  Real volume_;                // (2 pi)^d
+  Real length_;                // the torus's period L in each direction
+  Real volume_;                // L^d
   tsi::RealVector a_;          // (1 + eps |k|^2)^{1/4}
   tsi::RealVector inverse_a_;  // its inverse
   tsi::RealVector remainder_;  // A_k on u's and on v's coefficients
@@ -326,15 +339,20 @@ void register_klein_gordon_complex(tsi::Registry& registry) {
   entry.info.name = "klein-gordon-complex";
   entry.info.aliases = {"kg-complex"};
   entry.info.summary =
-      "nonlinear Klein-Gordon with complex z, eps z_tt - lap z + z/eps + lambda |z|^2 z = 0 on the torus [0, 2 pi)^dims "
+      "nonlinear Klein-Gordon with complex z, eps z_tt - lap z + z/eps + lambda |z|^2 z = 0 on the torus [0, L)^dims "
       "(Chartier-Crouseilles-Lemou-Mehats), state (u, v) in Fourier, dim 2 n_x [n_y [n_z]]";
   entry.info.params = tsi::spectral_grid_params("samples of u, then of v,");
   entry.info.params.push_back(
       tsi::string_param("data", "cos-sin",
                         "initial data: \"cos-sin\" (z = (1+i) cos x, eps z_t = (1-i) sin x), \"faou-schratz\" "
                         "(z = cos x, eps z_t = sin(x)/4 + cos(x)/2) or \"cai-zhou\" (z = (2+i)/sqrt5 cos x, eps z_t = "
-                        "(1+i)/sqrt2 sin x + cos(x)/2); products over the directions in 2-D and 3-D")
-          .choices({"cos-sin", "faou-schratz", "cai-zhou"}));
+                        "(1+i)/sqrt2 sin x + cos(x)/2) or \"bao-dong\" (z = sech(x^2), eps z_t = 0, x centred in the box: "
+                        "give a length of about 16 and lambda 4 for Bao and Dong's); products over the directions in "
+                        "2-D and 3-D")
+          .choices({"cos-sin", "faou-schratz", "cai-zhou", "bao-dong"}));
+  entry.info.params.push_back(tsi::number_param("length", tsi::two_pi,
+                                                "the torus's period L in each direction (wave numbers 2 pi k / L)")
+                                  .range(1e-3, 1e6));
   entry.info.params.push_back(
       tsi::number_param("lambda", 1.0, "coefficient of the cubic term lambda |z|^2 z")
           .check([](const tsi::Json& v) { return std::isfinite(v.get<double>()); }, "a finite number"));
@@ -345,9 +363,12 @@ void register_klein_gordon_complex(tsi::Registry& registry) {
   entry.create = [](const tsi::Params& p) {
     std::vector<int> shape = tsi::spectral_grid_shape(p);
     const std::string name = p.string("data");
-    const Data data = name == "faou-schratz" ? Data::faou_schratz : name == "cai-zhou" ? Data::cai_zhou : Data::cos_sin;
+    const Data data = name == "faou-schratz" ? Data::faou_schratz
+                      : name == "cai-zhou"   ? Data::cai_zhou
+                      : name == "bao-dong"   ? Data::bao_dong
+                                             : Data::cos_sin;
     return std::make_unique<KleinGordonComplex>(p.number("eps"), std::move(shape), p.number("lambda"), data,
-                                                p.context().fft);
+                                                static_cast<Real>(p.number("length")), p.context().fft);
   };
   registry.add_model(std::move(entry));
 }
