@@ -20,9 +20,10 @@ inline const std::vector<std::pair<double, std::string>>& micromacro_cases() {
   return cases;
 }
 
-/// (u, v) on the 128-point grid from the reference file of `name`.
-inline Vector micromacro_reference(const std::string& name) {
-  std::ifstream in(std::string(TSI_TEST_SOURCE_DIR) + "/tests/data/rivals/micromacro-cos-sin/donnee_" + name + ".txt");
+/// (u, v) on 128 points from a file of one line per point, Re u, Im u, Re v, Im v (the
+/// references' layout), at `path` under tests/data/rivals/.
+inline Vector read_uv_file(const std::string& path) {
+  std::ifstream in(std::string(TSI_TEST_SOURCE_DIR) + "/tests/data/rivals/" + path);
   REQUIRE(in);
   Vector uv(256);
   for (int j = 0; j < 128; ++j) {
@@ -33,6 +34,11 @@ inline Vector micromacro_reference(const std::string& name) {
     uv(128 + j) = Complex(vr, vi);
   }
   return uv;
+}
+
+/// (u, v) on the 128-point grid from the reference file of `name`.
+inline Vector micromacro_reference(const std::string& name) {
+  return read_uv_file("micromacro-cos-sin/donnee_" + name + ".txt");
 }
 
 }  // namespace tsi::test

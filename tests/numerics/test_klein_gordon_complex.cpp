@@ -7,7 +7,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <fstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -113,16 +112,7 @@ TEST_CASE("klein-gordon-complex: Bao and Dong's data on a box of length 16 are o
   for (const auto& [eps, name] : std::vector<std::pair<double, std::string>>{{1.0, "1"}, {0.1, "0_1"}}) {
     auto model = harness.model_with("klein-gordon-complex", eps,
                                     {{"n_x", 128}, {"data", "bao-dong"}, {"length", 16.0}, {"lambda", 4.0}});
-    std::ifstream in(std::string(TSI_TEST_SOURCE_DIR) + "/tests/data/rivals/kg-complex-bao-dong/eps_" + name + ".txt");
-    REQUIRE(in);
-    Vector reference(256);
-    for (int j = 0; j < 128; ++j) {
-      double ur, ui, vr, vi;
-      in >> ur >> ui >> vr >> vi;
-      reference(j) = tsi::Complex(ur, ui);
-      reference(128 + j) = tsi::Complex(vr, vi);
-    }
-    REQUIRE(static_cast<bool>(in));
+    const Vector reference = tsi::test::read_uv_file("kg-complex-bao-dong/eps_" + name + ".txt");
     auto filtered = harness.reformulation("filtered", model);
     const Vector u = tsi::test::solve(*model, *filtered, *harness.scheme("rk78", {{"tol", 1e-13}}), 0.25, 1);
     const double error = model->error_norm(u - reference) / model->error_norm(reference);
