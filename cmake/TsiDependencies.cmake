@@ -39,3 +39,17 @@ if(TSI_WITH_MPI AND NOT MPI_CXX_FOUND)
   message(FATAL_ERROR "TSI_WITH_MPI is ON but no MPI was found (Debian: apt-get install libopenmpi-dev openmpi-bin)")
 endif()
 message(STATUS "tsi: MPI studies ${TSI_WITH_MPI}")
+# FFTW's MPI transforms (Debian's libfftw3-mpi-dev: libfftw3_mpi, libfftw3l_mpi), with MPI: a
+# split run's spectral grid in slabs over the ranks (tsi run --split; apps/tsi/split_processes.cpp).
+if(TSI_WITH_MPI AND NOT TSI_PRECISION STREQUAL "quad")  # a quad build never splits
+  if(TSI_PRECISION STREQUAL "long-double")
+    set(TSI_FFTW_MPI_NAME fftw3l_mpi)
+  else()
+    set(TSI_FFTW_MPI_NAME fftw3_mpi)
+  endif()
+  find_library(TSI_FFTW_MPI_LIBRARY NAMES ${TSI_FFTW_MPI_NAME} HINTS ${FFTW3_LIBRARY_DIRS})
+  if(NOT TSI_FFTW_MPI_LIBRARY)
+    message(FATAL_ERROR "TSI_WITH_MPI is ON but FFTW's MPI library (${TSI_FFTW_MPI_NAME}) was not found (Debian: "
+                        "apt-get install libfftw3-mpi-dev)")
+  endif()
+endif()

@@ -422,9 +422,9 @@ void check_split_run(const Json& config, const Assembly& assembly, const Registr
   const Model& model = *assembly.model;
   if (!model.split_across_processes())
     throw ConfigError("--split", fmt::format("the model \"{}\" does not split its state over processes; expected "
-                                             "a model that does (vlasov-poisson-2d: its particles)",
+                                             "a model that does (vlasov-poisson-2d: its particles; nls and "
+                                             "klein-gordon-complex on a 2-D or 3-D grid: slabs of it)",
                                              config["model"]["name"].get<std::string>()));
-  if (model.is_complex()) throw ConfigError("--split", "a complex state is not split over processes");
   if (assembly.traits.adaptive)
     throw ConfigError("scheme", fmt::format("\"{}\" chooses its steps from the state, which a split run holds in "
                                             "shares; expected a scheme with fixed steps under --split",
@@ -691,8 +691,11 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   RunRecorder recorder(*model, *reformulation, u0, config, outcome.csv_file);
   recorder.split_over(split);
   // A state of the whole run: a split run's shares gathered on rank 0 (empty elsewhere).
-  const auto whole = [split](const Vector& local) -> Vector {
-    return split ? Vector(split->gather(local.real()).cast<Complex>()) : local;
+  const auto whole = [split, complex = model->is_complex()](const Vector& local) -> Vector {
+    if (!split) return local;
+    Vector all = split->gather(local.real()).cast<Complex>();
+    if (complex) all.imag() = split->gather(local.imag());
+    return all;
   };
   // u between the steps (output.times), from the scheme's states interpolated in t.
   std::unique_ptr<DenseOutput> dense;

@@ -6,8 +6,11 @@
 #include "tsi/error.hpp"
 
 #ifdef TSI_WITH_MPI
+#include <fftw3-mpi.h>
+#include <fmt/format.h>
 #include <mpi.h>
 
+#include <algorithm>
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +18,8 @@
 #include <string>
 #include <type_traits>
 #include <vector>
+
+#include "tsi/spectral_grid.hpp"
 #endif
 
 namespace tsi::app {
@@ -25,6 +30,81 @@ namespace {
 // The build's Real as MPI sees it (a quad build refuses to split: MPI has no float128).
 const MPI_Datatype mpi_real = std::is_same_v<Real, double> ? MPI_DOUBLE : MPI_LONG_DOUBLE;
 
+// FFTW's MPI interface in the build's precision (libfftw3_mpi, libfftw3l_mpi; a quad build
+// never splits, and FFTW has no MPI interface in quad).
+#if !defined(TSI_PRECISION_QUAD)
+#if defined(TSI_PRECISION_LONG_DOUBLE)
+#define TSI_FFTW_MPI(name) fftwl_mpi_##name
+#define TSI_FFTW_PLAIN(name) fftwl_##name
+#else
+#define TSI_FFTW_MPI(name) fftw_mpi_##name
+#define TSI_FFTW_PLAIN(name) fftw_##name
+#endif
+
+// The slab transforms of a split run (Collective::slab_transforms): one FFTW MPI plan each
+// way for one field, its first direction in equal blocks of rows (grid_slab's), input and
+// output in the same layout (no FFTW_MPI_TRANSPOSED_OUT: the state's slab is the same in both
+// spaces, so the linear flow and the cubic term stay local). The columns go through the plans
+// one at a time, via FFTW's own buffer, which holds the transposes' room too.
+class MpiSlabTransforms final : public FieldTransforms {
+ public:
+  MpiSlabTransforms(const SpectralGrid& grid, Index columns, int processes) : columns_(columns) {
+    const GridSlab slab = grid_slab_for(grid, processes);
+    std::vector<ptrdiff_t> n(grid.shape().begin(), grid.shape().end());
+    ptrdiff_t local_rows = 0, first_row = 0;
+    const ptrdiff_t room = TSI_FFTW_MPI(local_size_many)(grid.dims(), n.data(), 1, static_cast<ptrdiff_t>(slab.rows),
+                                                         MPI_COMM_WORLD, &local_rows, &first_row);
+    points_ = slab.points();
+    buffer_ = reinterpret_cast<Complex*>(TSI_FFTW_PLAIN(alloc_complex)(static_cast<size_t>(std::max<ptrdiff_t>(room, 1))));
+    if (!buffer_) throw Error(fmt::format("--split: cannot allocate the slab transforms' {} values", room));
+    auto* data = reinterpret_cast<TSI_FFTW_PLAIN(complex)*>(buffer_);
+    const int signs[2] = {FFTW_FORWARD, FFTW_BACKWARD};
+    for (int d = 0; d < 2; ++d)
+      plans_[d] = TSI_FFTW_MPI(plan_many_dft)(grid.dims(), n.data(), 1, static_cast<ptrdiff_t>(slab.rows),
+                                              FFTW_MPI_DEFAULT_BLOCK, data, data, MPI_COMM_WORLD, signs[d],
+                                              FFTW_ESTIMATE);
+    if (!plans_[0] || !plans_[1] || local_rows != slab.rows) {
+      release();
+      throw Error(fmt::format("--split: FFTW could not plan the slab transforms of the grid {} over {} processes",
+                              grid.describe(), processes));
+    }
+    data_.resize(points_, columns_);
+    data_.setZero();
+  }
+  ~MpiSlabTransforms() override { release(); }
+  MpiSlabTransforms(const MpiSlabTransforms&) = delete;
+  MpiSlabTransforms& operator=(const MpiSlabTransforms&) = delete;
+
+  Eigen::Map<Matrix> data() override { return Eigen::Map<Matrix>(data_.data(), points_, columns_); }
+  void forward() override { execute(0); }
+  void backward() override { execute(1); }
+  Index columns() const override { return columns_; }
+
+ private:
+  static GridSlab grid_slab_for(const SpectralGrid& grid, int processes) {
+    const Index rows = grid.shape().front() / processes;
+    return {0, rows, grid.points() / grid.shape().front()};
+  }
+  void execute(int direction) {
+    for (Index j = 0; j < columns_; ++j) {
+      std::copy_n(data_.col(j).data(), points_, buffer_);
+      TSI_FFTW_PLAIN(execute)(static_cast<TSI_FFTW_PLAIN(plan)>(plans_[direction]));
+      std::copy_n(buffer_, points_, data_.col(j).data());
+    }
+  }
+  void release() {
+    for (void*& plan : plans_)
+      if (plan) TSI_FFTW_PLAIN(destroy_plan)(static_cast<TSI_FFTW_PLAIN(plan)>(plan)), plan = nullptr;
+    if (buffer_) TSI_FFTW_PLAIN(free)(buffer_), buffer_ = nullptr;
+  }
+
+  Index points_ = 0, columns_;
+  Complex* buffer_ = nullptr;
+  void* plans_[2] = {nullptr, nullptr};  // forward, backward
+  Matrix data_;
+};
+#endif  // !TSI_PRECISION_QUAD
+
 class MpiWorld final : public Collective {
  public:
   MpiWorld() {
@@ -32,8 +112,16 @@ class MpiWorld final : public Collective {
     MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
+#if !defined(TSI_PRECISION_QUAD)
+    TSI_FFTW_MPI(init)();
+#endif
   }
-  ~MpiWorld() override { MPI_Finalize(); }
+  ~MpiWorld() override {
+#if !defined(TSI_PRECISION_QUAD)
+    TSI_FFTW_MPI(cleanup)();
+#endif
+    MPI_Finalize();
+  }
 
   int rank() const override { return rank_; }
   int size() const override { return size_; }
@@ -53,6 +141,12 @@ class MpiWorld final : public Collective {
                 MPI_COMM_WORLD);
     return all;
   }
+#if !defined(TSI_PRECISION_QUAD)
+  std::unique_ptr<FieldTransforms> slab_transforms(const SpectralGrid& grid, Index columns) const override {
+    grid_slab(grid, this);  // the checks, naming the grid's fields
+    return std::make_unique<MpiSlabTransforms>(grid, columns, size_);
+  }
+#endif
   [[noreturn]] void abort(int code) const override {
     std::fflush(stdout);
     std::fflush(stderr);

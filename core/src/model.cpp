@@ -5,6 +5,7 @@
 #include <string>
 
 #include "central_difference.hpp"
+#include "tsi/collective.hpp"
 #include "tsi/error.hpp"
 
 namespace tsi {
@@ -108,7 +109,7 @@ Real Model::remainder_energy(const Vector& u) const {
   const Vector i_omega_u = (Complex(0.0, 1.0) * omega.cast<Complex>()).cwiseProduct(u);
   Vector r(u.size());
   h->apply_J(i_omega_u, r);
-  return -0.5 * inner(r, u);
+  return -0.5 * summed(inner(r, u));
 }
 
 void Model::apply_A(const Vector& u, Vector& out) const {
@@ -130,10 +131,10 @@ Real Model::oscillatory_energy(const Vector& u) const {
   if (!h) no_hamiltonian("oscillatory energy");
   Vector mu(u.size());
   h->apply_M(u, mu);
-  return inner(mu, u) / (2.0 * eps_);
+  return summed(inner(mu, u)) / (2.0 * eps_);
 }
 
-Real Model::mass(const Vector& u) const { return inner(u, u); }
+Real Model::mass(const Vector& u) const { return summed(inner(u, u)); }
 
 Real Model::energy(const Vector& u) const {
   const HamiltonianStructure* h = hamiltonian();
@@ -163,7 +164,7 @@ Vector Model::to_physical(const Vector& u) const {
 
 Real Model::error_norm(const Vector& x) const {
   const PhysicalVariables* p = physical_variables();
-  return p ? p->error_norm(x) : x.norm();
+  return p ? p->error_norm(x) : std::sqrt(summed(x.squaredNorm()));
 }
 
 Real Model::rounding_floor(const Vector& u) const {
@@ -174,6 +175,11 @@ Real Model::rounding_floor(const Vector& u) const {
   }
   const Vector x = to_physical(u);
   return error_norm(to_physical(rounded) - x) / std::max<Real>(error_norm(x), 1e-300);
+}
+
+Real Model::summed(Real local) const {
+  const Collective* split = processes();
+  return split ? split->sum(local) : local;
 }
 
 Vector Model::linear_flow(Real tau, const Vector& u) const { return linear_flow(tau, Vector(u)); }

@@ -8,6 +8,7 @@
 
 #include "fftw_planner.hpp"
 #include "fftw_precision.hpp"
+#include "tsi/collective.hpp"
 #include "tsi/error.hpp"
 #include "tsi/fft.hpp"
 #include "tsi/memory.hpp"
@@ -224,9 +225,46 @@ void GridTransforms::execute(int direction) {
 void GridTransforms::forward() { execute(0); }
 void GridTransforms::backward() { execute(1); }
 
-Matrix& GridTransforms::scratch() {
-  if (scratch_.size() == 0) scratch_.resize(points_, columns_);
+Matrix& FieldTransforms::scratch() {
+  if (scratch_.size() == 0) scratch_.resize(data().rows(), columns());
   return scratch_;
+}
+
+GridSlab grid_slab(const SpectralGrid& grid, const Collective* split) {
+  const Index rows = grid.shape().front();
+  GridSlab slab{0, rows, grid.points() / rows};
+  if (!split) return slab;
+  const int processes = split->size();
+  if (grid.dims() == 1)
+    throw ConfigError("model.dims", fmt::format("got 1 with --split over {} processes; expected 2 or 3: a grid is "
+                                                "split in slabs of its first direction, and a 1-D grid has no "
+                                                "second direction to keep whole",
+                                                processes));
+  if (rows < processes)
+    throw ConfigError("model.n_x", fmt::format("got {} with --split over {} processes; expected at least one slab "
+                                               "(an index of the first direction) per process: n_x >= {}, or at "
+                                               "most {} processes",
+                                               rows, processes, processes, rows));
+  if (rows % processes != 0)
+    throw ConfigError("model.n_x", fmt::format("got {} with --split over {} processes; expected a multiple of {}: "
+                                               "the slabs are equal (n_x / processes indices of the first "
+                                               "direction each)",
+                                               rows, processes, processes));
+  slab.rows = rows / processes;
+  slab.first_row = slab.rows * split->rank();
+  return slab;
+}
+
+std::unique_ptr<FieldTransforms> Collective::slab_transforms(const SpectralGrid& grid, Index /*columns*/) const {
+  throw Error(fmt::format("the processes of this split run have no slab transforms for the grid {} (a Collective "
+                          "without FFTW's MPI transforms)",
+                          grid.describe()));
+}
+
+std::unique_ptr<FieldTransforms> make_field_transforms(const SpectralGrid& grid, Index columns,
+                                                       ThreadLimit fftw_threads, const Collective* split) {
+  if (split) return split->slab_transforms(grid, columns);
+  return std::make_unique<GridTransforms>(grid, columns, fftw_threads);
 }
 
 RealGridTransforms::RealGridTransforms(const SpectralGrid& grid, Index columns, ThreadLimit fftw_threads)
@@ -313,10 +351,10 @@ RealMatrix& RealGridTransforms::scratch() {
   return scratch_;
 }
 
-GridTransforms& GridTransformsPool::get(Index columns) {
+FieldTransforms& GridTransformsPool::get(Index columns) {
   auto it = batches_.find(columns);
   if (it == batches_.end())
-    it = batches_.emplace(columns, std::make_unique<GridTransforms>(grid_, columns, fftw_threads_)).first;
+    it = batches_.emplace(columns, make_field_transforms(grid_, columns, fftw_threads_, split_)).first;
   return *it->second;
 }
 

@@ -85,7 +85,7 @@ class TimeAsVariable final : public Model, public PhysicalVariables {
       invariant.value = [value = std::move(invariant.value), d = d_](const Vector& u) { return value(u.head(d)); };
     return out;
   }
-  bool split_across_processes() const override { return model_->split_across_processes(); }
+  const Collective* processes() const override { return model_->processes(); }
   void canonicalize_physical(Vector& x) const override { model_->canonicalize_physical(x); }
 
   // Physical variables are the model's own (its PhysicalVariables, if any), without t.

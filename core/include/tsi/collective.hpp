@@ -1,10 +1,14 @@
 #pragma once
 #include <algorithm>
+#include <memory>
 
 #include "tsi/export.hpp"
 #include "tsi/types.hpp"
 
 namespace tsi {
+
+class FieldTransforms;
+class SpectralGrid;
 
 /// The processes one run is split over (a particle-in-cell run's particles over MPI ranks,
 /// `mpirun -np P tsi run --split`): every process holds its part of the state, and these
@@ -23,6 +27,11 @@ class TSI_API Collective {
   /// The processes' `local` vectors one after the other, in rank order, on rank 0 (an empty
   /// vector elsewhere).
   virtual RealVector gather(const RealVector& local) const = 0;
+  /// Transforms of `columns` complex fields on `grid`, its first direction split over the
+  /// processes in grid_slab's slabs: each process's buffer holds its slab, in both spaces (the
+  /// transposes between are the transforms' own). Every process makes and executes them alike,
+  /// in the same order. A Collective without them (the default) throws tsi::Error.
+  virtual std::unique_ptr<FieldTransforms> slab_transforms(const SpectralGrid& grid, Index columns) const;
   /// Stops every process with exit code `code`: a failure on one of them, which the others,
   /// waiting in a reduction, would never learn of.
   [[noreturn]] virtual void abort(int code) const = 0;

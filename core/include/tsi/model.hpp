@@ -10,6 +10,8 @@
 
 namespace tsi {
 
+class Collective;
+
 /// The general class u' = (1/eps) A u + R u + f(t, u) (SPEC.md section 7). A model gives a
 /// small required core: its size, whether it is complex, the action of e^{A tau}
 /// (2 pi-periodic) and f, on batches (one state per column, so that the two-scale
@@ -75,11 +77,14 @@ class TSI_API Model {
   virtual double max_linear_frequency() const { return 1.0; }
   /// The model's own invariants beyond H, I and m (none by default).
   virtual std::vector<ModelInvariant> invariants() const { return {}; }
-  /// True when the model holds only this process's share of the state of a run split over
-  /// processes (Params' context has a Collective): its field, invariants and error norm reduce
-  /// over the processes, and physical_shape() is the whole state's. vlasov-poisson-2d's
-  /// particles; no other model splits (the runner refuses to split them).
-  virtual bool split_across_processes() const { return false; }
+  /// The processes of a run split over them (tsi run --split: Params' context has a
+  /// Collective) when the model holds only this process's share of the state, else null: its
+  /// field and its own invariants then reduce over the processes, the core's inner products
+  /// (I, m, the default error norm) reduce through it, and physical_shape() is the whole
+  /// state's. vlasov-poisson-2d's particles, and the slabs of nls and klein-gordon-complex on a
+  /// 2-D or 3-D grid; the runner refuses to split any other model.
+  virtual const Collective* processes() const { return nullptr; }
+  bool split_across_processes() const { return processes() != nullptr; }
   /// Physical variables as a state file keeps them for a run to start from (state.npy): a
   /// periodic model's positions brought into its box. Unchanged by default.
   virtual void canonicalize_physical(Vector& /*x*/) const {}
@@ -160,6 +165,8 @@ class TSI_API Model {
   explicit Model(Real eps);
 
  private:
+  /// A number summed over the processes of a split run (itself on one process).
+  Real summed(Real local) const;
   Real eps_;
 };
 

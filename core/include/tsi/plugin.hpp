@@ -14,7 +14,7 @@
 /// order, the ABI version, the size of TsiPluginInfo, the tsi major version and the layout of
 /// every structure the plugin exchanges with tsi, before it calls register_fn.
 /// What is stable and what bumps the version: docs/reference/plugin-abi.md.
-inline constexpr std::uint32_t TSI_PLUGIN_ABI_VERSION = 24;
+inline constexpr std::uint32_t TSI_PLUGIN_ABI_VERSION = 25;
 
 extern "C" {
 

@@ -14,6 +14,8 @@
 
 namespace tsi {
 
+class Collective;
+
 namespace detail {
 class LeadingDirections;  // a large field's directions before the last, by FftBatch's blocks
 }
@@ -85,13 +87,63 @@ class TSI_API SpectralGrid {
   RealVector laplacian_;
 };
 
-/// Batched transforms of `columns` fields on a SpectralGrid, each way: a points x columns
-/// buffer, field j in column j (contiguous), one d-dimensional FFTW plan each way over the
-/// whole batch. Sign convention FFTW's: forward is sum_x a(x) e^{-i m.x}, backward
-/// sum_m a_m e^{+i m.x}, neither normalised, so backward(forward(a)) = points() a. Owns its
-/// plans and buffer: a model binding its tau grid makes one of its own (no locks between
-/// bindings); not synchronised itself.
-class TSI_API GridTransforms {
+/// The part of a SpectralGrid that one process of a split run holds (tsi run --split): the
+/// indices [first_row, first_row + rows) of the first direction, with every index of the
+/// others, in both spaces (points and Fourier coefficients alike). In C order that is the
+/// contiguous points [first_point(), first_point() + points()). One process holds the whole grid.
+struct TSI_API GridSlab {
+  Index first_row = 0, rows = 0, row_points = 0;  ///< row_points: the points of one index of the first direction
+  Index first_point() const { return first_row * row_points; }
+  Index points() const { return rows * row_points; }
+};
+/// The slab of `grid` this process holds: the whole grid without `split`, else rank r of P holds
+/// the rows [r n_1 / P, (r + 1) n_1 / P). A ConfigError naming `model.dims` for a 1-D grid
+/// (FFTW's 1-D MPI transforms change the layout between the spaces), `model.n_x` where there are
+/// more processes than rows or n_1 is not a multiple of the processes.
+TSI_API GridSlab grid_slab(const SpectralGrid& grid, const Collective* split);
+/// Calls point(index, x) for every point of `slab` in C order, index counted from the slab's first
+/// point and x the point's coordinates (x_1 .. x_d), as SpectralGrid::for_each_point does.
+template <class Point>
+void for_each_slab_point(const SpectralGrid& grid, const GridSlab& slab, Point&& point) {
+  std::array<Real, 3> x{0.0, 0.0, 0.0};
+  for (Index p = 0; p < slab.points(); ++p) {
+    Index rest = slab.first_point() + p;  // the global index, its directions from the last
+    for (int i = grid.dims() - 1; i >= 0; --i) {
+      const int n = grid.shape()[static_cast<std::size_t>(i)];
+      x[static_cast<std::size_t>(i)] = grid.coordinate(i, static_cast<int>(rest % n));
+      rest /= n;
+    }
+    point(p, x);
+  }
+}
+
+/// Transforms of columns() fields on a SpectralGrid (or on this process's slab of it), each way,
+/// in place on a points x columns buffer, field j in column j. Sign convention FFTW's: forward
+/// is sum_x a(x) e^{-i m.x}, backward sum_m a_m e^{+i m.x}, neither normalised, so
+/// backward(forward(a)) = points a. GridTransforms on one process; on the slabs of a split
+/// run, Collective::slab_transforms (FFTW's MPI transforms; every process calls them alike).
+class TSI_API FieldTransforms {
+ public:
+  virtual ~FieldTransforms() = default;
+  /// points x columns: column j is field j (grid values or Fourier coefficients).
+  virtual Eigen::Map<Matrix> data() = 0;
+  /// Unnormalised: sum_x a(x) e^{-i m.x}.
+  virtual void forward() = 0;
+  /// Unnormalised: sum_m a_m e^{+i m.x}.
+  virtual void backward() = 0;
+  /// Fields it transforms at once.
+  virtual Index columns() const = 0;
+  /// Work space of data()'s shape (a second grid, as a derivative needs), allocated on first use.
+  Matrix& scratch();
+
+ private:
+  Matrix scratch_;
+};
+
+/// Batched transforms of `columns` fields on a whole SpectralGrid: one d-dimensional FFTW plan
+/// each way over the whole batch. Owns its plans and buffer: a model binding its tau grid makes
+/// one of its own (no locks between bindings); not synchronised itself.
+class TSI_API GridTransforms final : public FieldTransforms {
  public:
   /// `fftw_threads`: FFTW's own threads for the batch (the run's Context::fft).
   GridTransforms(const SpectralGrid& grid, Index columns, ThreadLimit fftw_threads = {});
@@ -99,16 +151,10 @@ class TSI_API GridTransforms {
   GridTransforms(const GridTransforms&) = delete;
   GridTransforms& operator=(const GridTransforms&) = delete;
 
-  /// points x columns: column j is field j (grid values or Fourier coefficients).
-  Eigen::Map<Matrix> data() { return Eigen::Map<Matrix>(buffer_, points_, columns_); }
-  /// Unnormalised: sum_x a(x) e^{-i m.x}.
-  void forward();
-  /// Unnormalised: sum_m a_m e^{+i m.x}.
-  void backward();
-  /// Work space of the same shape (a second grid, as a derivative needs), allocated on first use.
-  Matrix& scratch();
-  /// Fields it transforms at once.
-  Index columns() const { return columns_; }
+  Eigen::Map<Matrix> data() override { return Eigen::Map<Matrix>(buffer_, points_, columns_); }
+  void forward() override;
+  void backward() override;
+  Index columns() const override { return columns_; }
 
  private:
   void execute(int direction);
@@ -116,8 +162,12 @@ class TSI_API GridTransforms {
   Complex* buffer_ = nullptr;
   std::unique_ptr<detail::LeadingDirections> leading_;  // a large multi-dimensional field: by direction
   void* plans_[2] = {nullptr, nullptr};                  // forward, backward
-  Matrix scratch_;
 };
+
+/// The transforms of `columns` fields on this process's part of `grid`: GridTransforms without
+/// `split`, else the split run's slab transforms (grid_slab's slabs).
+TSI_API std::unique_ptr<FieldTransforms> make_field_transforms(const SpectralGrid& grid, Index columns,
+                                                               ThreadLimit fftw_threads, const Collective* split);
 
 /// Real-to-complex transforms of `columns` real fields on a SpectralGrid: field j's values
 /// (column j of points x columns) to its half spectrum (column j of half_points() x columns,
@@ -155,20 +205,23 @@ class TSI_API RealGridTransforms {
   RealMatrix scratch_;
 };
 
-/// GridTransforms for every batch size a model meets, planned on first use and kept: a run sees
+/// FieldTransforms for every batch size a model meets, planned on first use and kept: a run sees
 /// two or three sizes (1 and n_tau, or a slice of n_tau), so nothing is planned inside a step
-/// after the first call. Not synchronised: the model serialises its calls (the buffers are
-/// shared work space).
+/// after the first call. With `split`, a split run's slab transforms (make_field_transforms).
+/// Not synchronised: the model serialises its calls (the buffers are shared work space).
 class TSI_API GridTransformsPool {
  public:
-  GridTransformsPool(const SpectralGrid& grid, ThreadLimit fftw_threads = {}) : grid_(grid), fftw_threads_(fftw_threads) {}
-  GridTransforms& get(Index columns);
+  GridTransformsPool(const SpectralGrid& grid, ThreadLimit fftw_threads = {}, const Collective* split = nullptr)
+      : grid_(grid), fftw_threads_(fftw_threads), split_(split) {}
+  FieldTransforms& get(Index columns);
   ThreadLimit fftw_threads() const { return fftw_threads_; }
+  const Collective* split() const { return split_; }
 
  private:
   const SpectralGrid& grid_;
   ThreadLimit fftw_threads_;
-  std::map<Index, std::unique_ptr<GridTransforms>> batches_;
+  const Collective* split_;
+  std::map<Index, std::unique_ptr<FieldTransforms>> batches_;
 };
 
 /// The parameters of a model on a SpectralGrid: `dims` (1, 2 or 3, default 1) and the points

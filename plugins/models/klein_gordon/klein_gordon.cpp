@@ -290,7 +290,7 @@ class KleinGordon final : public tsi::Model,
       throw tsi::ConfigError("model.u0", "got " + std::to_string(v.size()) + " samples, expected " +
                                              std::to_string(n_x_) + " (the grid " + grid_.describe() + ")");
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batch(1);
+    tsi::FieldTransforms& b = batch(1);
     auto w = b.data();
     w.col(0) = v;
     b.forward();
@@ -301,7 +301,7 @@ class KleinGordon final : public tsi::Model,
   // Q - i P), which is from_physical(q - i (1 - e^2 d_xx)^{-1/2} p).
   Vector from_field_and_momentum(const FieldAndMomentum& data) const {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batch(1);
+    tsi::FieldTransforms& b = batch(1);
     auto w = b.data();
     w.col(0) = data.z.cast<Complex>();
     b.forward();
@@ -316,7 +316,7 @@ class KleinGordon final : public tsi::Model,
   // c -> v = backward(a^{-1} c) / sqrt(2 pi).
   Vector to_physical(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batch(1);
+    tsi::FieldTransforms& b = batch(1);
     auto w = b.data();
     w.col(0) = inverse_a_.cwiseProduct(c);
     b.backward();
@@ -340,7 +340,7 @@ class KleinGordon final : public tsi::Model,
   void to_second_order(const Vector& c, tsi::RealVector& x, tsi::RealVector& v) const override {
     const Vector physical = to_physical(c);
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batch(1);
+    tsi::FieldTransforms& b = batch(1);
     auto w = b.data();
     w.col(0) = physical.real().cast<Complex>();
     b.forward();
@@ -357,7 +357,7 @@ class KleinGordon final : public tsi::Model,
     FieldAndMomentum data;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      tsi::GridTransforms& b = batch(1);
+      tsi::FieldTransforms& b = batch(1);
       auto w = b.data();
       w.col(0) = x.head(n_x_).cast<Complex>() + Complex(0, 1) * x.tail(n_x_).cast<Complex>();
       b.backward();
@@ -371,7 +371,7 @@ class KleinGordon final : public tsi::Model,
   // g_k = -(lambda / e^2) (z^3)_k, z = Re backward(q).
   void force(const tsi::RealVector& x, tsi::RealVector& g) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batch(1);
+    tsi::FieldTransforms& b = batch(1);
     auto w = b.data();
     w.col(0) = x.head(n_x_).cast<Complex>() + Complex(0, 1) * x.tail(n_x_).cast<Complex>();
     b.backward();
@@ -387,7 +387,7 @@ class KleinGordon final : public tsi::Model,
  private:
   // The transforms for batches of `columns` states, planned on first use and kept. Callers
   // hold mutex_.
-  tsi::GridTransforms& batch(Index columns) const { return batches_.get(columns); }
+  tsi::FieldTransforms& batch(Index columns) const { return batches_.get(columns); }
   // Real transforms for batches of `columns` fields, planned on first use and kept. Callers
   // hold mutex_.
   tsi::RealGridTransforms& real_batch(Index columns) const {

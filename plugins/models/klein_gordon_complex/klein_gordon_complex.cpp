@@ -205,7 +205,7 @@ class KleinGordonComplex final : public tsi::Model,
   Vector to_physical(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
     Vector uv(2 * n_);
-    tsi::GridTransforms& b = batches_.get(1);
+    tsi::FieldTransforms& b = batches_.get(1);
     for (int half = 0; half < 2; ++half) {
       b.data().col(0) = inverse_a_.cwiseProduct(c.segment(half * n_, n_));
       b.backward();
@@ -229,7 +229,7 @@ class KleinGordonComplex final : public tsi::Model,
     const Vector uv = to_physical(c);
     std::lock_guard<std::mutex> lock(mutex_);
     const Vector u = uv.head(n_), conj_v = uv.tail(n_).conjugate();
-    tsi::GridTransforms& b = batches_.get(1);
+    tsi::FieldTransforms& b = batches_.get(1);
     b.data().col(0) = (u + conj_v) / Real(2);
     b.forward();
     const Vector z = b.data().col(0) / point_count();
@@ -244,7 +244,7 @@ class KleinGordonComplex final : public tsi::Model,
   // u = z - i <D>^{-1} (eps z_t), v = conj z - i <D>^{-1} conj(eps z_t).
   void from_second_order(const tsi::RealVector& x, const tsi::RealVector& v, Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batches_.get(1);
+    tsi::FieldTransforms& b = batches_.get(1);
     b.data().col(0) = x.head(n_).cast<Complex>() + Complex(0, 1) * x.tail(n_).cast<Complex>();
     b.backward();
     const Vector z = b.data().col(0);
@@ -259,7 +259,7 @@ class KleinGordonComplex final : public tsi::Model,
   // g_k = -(lambda / eps) (|z|^2 z)_k, z = backward(z_k).
   void force(const tsi::RealVector& x, tsi::RealVector& g) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batches_.get(1);
+    tsi::FieldTransforms& b = batches_.get(1);
     b.data().col(0) = x.head(n_).cast<Complex>() + Complex(0, 1) * x.tail(n_).cast<Complex>();
     b.backward();
     const Vector z = b.data().col(0);
@@ -275,7 +275,7 @@ class KleinGordonComplex final : public tsi::Model,
   // c from the samples (u, v): c_u = (2 pi)^{d/2} / N a forward(u). Callers hold mutex_.
   Vector from_samples(const Vector& uv) const {
     Vector c(2 * n_);
-    tsi::GridTransforms& b = batches_.get(1);
+    tsi::FieldTransforms& b = batches_.get(1);
     for (int half = 0; half < 2; ++half) {
       b.data().col(0) = uv.segment(half * n_, n_);
       b.forward();
@@ -286,7 +286,7 @@ class KleinGordonComplex final : public tsi::Model,
 
   // <D>^{-1} g on the grid. Callers hold mutex_.
   Vector inverse_D(const Vector& g) const {
-    tsi::GridTransforms& b = batches_.get(1);
+    tsi::FieldTransforms& b = batches_.get(1);
     b.data().col(0) = g;
     b.forward();
     b.data().col(0) = inverse_a_.array().square().matrix().cwiseProduct(b.data().col(0)) / point_count();
@@ -297,7 +297,7 @@ class KleinGordonComplex final : public tsi::Model,
   // z = (u + conj v) / 2 on the grid for every column, u = backward(a^{-1} c_u) / (2 pi)^{d/2}.
   // Callers hold mutex_.
   Matrix field_z(ConstMatrixRef c) const {
-    tsi::GridTransforms& b = batches_.get(c.cols());
+    tsi::FieldTransforms& b = batches_.get(c.cols());
     b.data() = inverse_a_.asDiagonal() * c.topRows(n_);
     b.backward();
     Matrix z = b.data();
@@ -310,7 +310,7 @@ class KleinGordonComplex final : public tsi::Model,
   // out = i (2 pi)^{d/2} / N a^{-1} (forward(f), forward(conj f)), column by column. Callers hold
   // mutex_.
   void spectral_field(const Matrix& f, MatrixRef out) const {
-    tsi::GridTransforms& b = batches_.get(f.cols());
+    tsi::FieldTransforms& b = batches_.get(f.cols());
     const Complex scale(0, std::sqrt(volume_) / point_count());
     b.data() = f;
     b.forward();

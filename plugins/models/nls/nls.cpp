@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "tsi/collective.hpp"
 #include "tsi/error.hpp"
 #include "tsi/model.hpp"
 #include "tsi/phase.hpp"
@@ -97,7 +98,8 @@ tsi::Matrix phase_table(const tsi::RealVector& taus, int n) {
 // where given, else by the recurrence), and their products e^{-i |m|^2 tau} at every point.
 class Phases {
  public:
-  explicit Phases(const tsi::SpectralGrid& grid) : grid_(grid) {
+  // `slab`: the points this process holds (the whole grid but in a split run).
+  Phases(const tsi::SpectralGrid& grid, const tsi::GridSlab& slab) : grid_(grid), slab_(slab) {
     for (int i = 0; i < grid.dims(); ++i)
       per_direction_[static_cast<std::size_t>(i)].resize(grid.shape()[static_cast<std::size_t>(i)] / 2 + 1);
   }
@@ -113,8 +115,8 @@ class Phases {
       for (Index m = 1; m < phase.size(); ++m) phase(m) = recurrence.next();
     }
   }
-  // use(point, e^{-i |m|^2 tau}) in the grid's order. In 1-D the direction's phase itself
-  // (no product: the 1-D values of before the grid, to the bit).
+  // use(point, e^{-i |m|^2 tau}) in the grid's order, point counted from the slab's first. In
+  // 1-D the direction's phase itself (no product: the 1-D values of before the grid, to the bit).
   template <class Use>
   void for_each_point(Use&& use) const {
     const std::vector<int>& last = grid_.folded(grid_.dims() - 1);
@@ -124,10 +126,10 @@ class Phases {
       for (Index q = 0; q < n_last; ++q) use(q, last_phase(last[static_cast<std::size_t>(q)]));
       return;
     }
-    const Index rows = grid_.points() / n_last;  // the leading directions' points
+    const Index rows = slab_.points() / n_last;  // the leading directions' points
     const int n2 = grid_.dims() == 3 ? grid_.shape()[1] : 1;
     for (Index r = 0; r < rows; ++r) {
-      const Index a = r / n2, b = r % n2;
+      const Index a = slab_.first_row + r / n2, b = r % n2;
       Complex lead = per_direction_[0](grid_.folded(0)[static_cast<std::size_t>(a)]);
       if (grid_.dims() == 3) lead = times(lead, per_direction_[1](grid_.folded(1)[static_cast<std::size_t>(b)]));
       for (Index q = 0; q < n_last; ++q) use(r * n_last + q, times(lead, last_phase(last[static_cast<std::size_t>(q)])));
@@ -136,6 +138,7 @@ class Phases {
 
  private:
   const tsi::SpectralGrid& grid_;
+  tsi::GridSlab slab_;
   std::array<Vector, 3> per_direction_;
 };
 
@@ -153,18 +156,25 @@ class Nls final : public tsi::Model,
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
   // dealias: the 2/3 rule on the field (and on u0), see the header.
   // wave: the plane wave of model.initial = "plane-wave", else none (the paper's data).
+  // split: the processes of tsi run --split, each holding a slab of the grid (tsi::grid_slab),
+  // or null for the whole grid here.
   Nls(Real eps, std::vector<int> shape, std::optional<tsi::PlaneWave> wave, bool dealias,
-      tsi::ThreadLimit fftw_threads = {})
+      tsi::ThreadLimit fftw_threads = {}, const tsi::Collective* split = nullptr)
       : Model(eps),
         grid_(std::move(shape)),
+        slab_(tsi::grid_slab(grid_, split)),
+        split_(split),
+        laplacian_(grid_.laplacian_symbol().segment(slab_.first_point(), slab_.points())),
         wave_(wave),
-        dealias_(dealias ? grid_.dealias_mask() : tsi::RealVector()),
+        dealias_(dealias ? tsi::RealVector(grid_.dealias_mask().segment(slab_.first_point(), slab_.points()))
+                         : tsi::RealVector()),
         volume_(std::pow(tsi::two_pi, grid_.dims())),
-        batches_(grid_, fftw_threads) {
+        batches_(grid_, fftw_threads, split) {
     batch(1);  // the single-state plans (filtered, direct, invariants)
   }
 
-  Index dim() const override { return grid_.points(); }
+  Index dim() const override { return slab_.points(); }
+  const tsi::Collective* processes() const override { return split_; }
   bool is_complex() const override { return true; }
 
   const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
@@ -176,7 +186,7 @@ class Nls final : public tsi::Model,
 
   // e^{JM tau}: mode m times e^{-i |m|^2 tau} = prod_i e^{-i m_i^2 tau}.
   void linear_flow(const tsi::RealVector& taus, MatrixRef u) const override {
-    Phases phases(grid_);
+    Phases phases(grid_, slab_);
     for (Index j = 0; j < u.cols(); ++j) {
       phases.set(taus(j), nullptr, j);
       phases.for_each_point([&](Index p, Complex e) { u(p, j) *= e; });
@@ -187,7 +197,7 @@ class Nls final : public tsi::Model,
   // With w = backward(c) = (2 pi)^{d/2} u:  out = -i forward(|w|^2 w) / ((2 pi)^d N).
   void nonlinear_field(ConstMatrixRef c, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batch(slice(c.cols()));
+    tsi::FieldTransforms& b = batch(slice(c.cols()));
     const Complex scale(0.0, -1.0 / (volume_ * point_count()));
     for (Index j0 = 0; j0 < c.cols(); j0 += b.columns()) {
       const Index k = std::min(b.columns(), c.cols() - j0);
@@ -216,8 +226,9 @@ class Nls final : public tsi::Model,
     GridField(const Nls& model, const tsi::RealVector& taus)
         : model_(model),
           taus_(taus),
-          phases_(model.grid_),
-          batch_(model.grid_, model.slice(taus.size()), model.batches_.fftw_threads()) {
+          phases_(model.grid_, model.slab_),
+          batch_(tsi::make_field_transforms(model.grid_, model.slice(taus.size()), model.batches_.fftw_threads(),
+                                            model.split_)) {
       // A small grid keeps its phases in tables (read, not recomputed: 15% of a step at
       // n_x = 16, n_tau = 256); a large one computes them as it goes.
       Index size = 0;
@@ -227,7 +238,7 @@ class Nls final : public tsi::Model,
           tables_[static_cast<std::size_t>(i)] = phase_table(taus, model.grid_.shape()[static_cast<std::size_t>(i)]);
     }
     void evaluate(MatrixRef c, MatrixRef out) override {
-      model_.fused_field(taus_, tables_[0].size() ? &tables_ : nullptr, phases_, batch_, c, out);
+      model_.fused_field(taus_, tables_[0].size() ? &tables_ : nullptr, phases_, *batch_, c, out);
     }
     bool in_place() const override { return true; }
 
@@ -237,7 +248,7 @@ class Nls final : public tsi::Model,
     tsi::RealVector taus_;
     PhaseTables tables_;
     Phases phases_;
-    tsi::GridTransforms batch_;
+    std::unique_ptr<tsi::FieldTransforms> batch_;
   };
 
 #if defined(TSI_WITH_CUDA)
@@ -272,8 +283,9 @@ class Nls final : public tsi::Model,
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
     return std::make_unique<GridField>(*this, taus);
   }
-  // Each binding owns its tables and transforms: bindings may run on different threads.
-  bool independent_tau_grid_bindings() const override { return true; }
+  // Each binding owns its tables and transforms: bindings may run on different threads, but
+  // not in a split run, whose transforms are collective (every process in the same order).
+  bool independent_tau_grid_bindings() const override { return !split_; }
 
   // f_tau in one pass each way: the phases e^{-i |m|^2 tau} are applied while the states are
   // copied into the batch, and their conjugates (the flow at -tau) while the result is copied
@@ -281,7 +293,7 @@ class Nls final : public tsi::Model,
   // come from phase_table's recurrence per direction (the same products as its table: with
   // `tables`, its values are read). A slice of b.columns() columns at a time, each read before
   // it is written: out may be c.
-  void fused_field(const tsi::RealVector& taus, const PhaseTables* tables, Phases& phases, tsi::GridTransforms& b,
+  void fused_field(const tsi::RealVector& taus, const PhaseTables* tables, Phases& phases, tsi::FieldTransforms& b,
                    MatrixRef c, MatrixRef out) const {
     const Real scale = 1.0 / (volume_ * point_count());
     for (Index j0 = 0; j0 < c.cols(); j0 += b.columns()) {
@@ -313,10 +325,10 @@ class Nls final : public tsi::Model,
     std::lock_guard<std::mutex> lock(mutex_);
     // A large batch (the prepared data's, a run's tau grid) gets transforms of its own for this
     // call, freed after it: the derivative is not needed while the run steps.
-    std::unique_ptr<tsi::GridTransforms> own;
+    std::unique_ptr<tsi::FieldTransforms> own;
     if (slice(c.cols()) < c.cols())
-      own = std::make_unique<tsi::GridTransforms>(grid_, slice(c.cols()), batches_.fftw_threads());
-    tsi::GridTransforms& b = own ? *own : batch(c.cols());
+      own = tsi::make_field_transforms(grid_, slice(c.cols()), batches_.fftw_threads(), split_);
+    tsi::FieldTransforms& b = own ? *own : batch(c.cols());
     tsi::Matrix& grid = b.scratch();
     const Complex scale(0.0, -1.0 / (volume_ * point_count()));
     for (Index j0 = 0; j0 < c.cols(); j0 += b.columns()) {
@@ -340,7 +352,7 @@ class Nls final : public tsi::Model,
   }
 
   void apply_M(const Vector& u, Vector& out) const override {
-    out = Real(2) * grid_.laplacian_symbol().cwiseProduct(u);
+    out = Real(2) * laplacian_.cwiseProduct(u);
   }
 
   void apply_J(const Vector& u, Vector& out) const override { out = Complex(0.0, -0.5) * u; }
@@ -348,11 +360,11 @@ class Nls final : public tsi::Model,
   // (1/2) ||u||_{L4}^4 = (1/2) ((2 pi)^d / N) sum |u_j|^4 = sum |w_j|^4 / (2 (2 pi)^d N).
   Real H1(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batch(1);
+    tsi::FieldTransforms& b = batch(1);
     auto w = b.data();
     w.col(0) = c;
     b.backward();
-    return w.col(0).cwiseAbs2().squaredNorm() / (2.0 * volume_ * point_count());
+    return summed(w.col(0).cwiseAbs2().squaredNorm()) / (2.0 * volume_ * point_count());
   }
 
   // The momentum along direction i, P_i = sum_m m_i |c_m|^2 = Im int conj(u) d_i u dx
@@ -370,10 +382,10 @@ class Nls final : public tsi::Model,
     for (int i = direction + 1; i < grid_.dims(); ++i) stride *= grid_.shape()[static_cast<std::size_t>(i)];
     Real p = 0.0;
     for (Index q = 0; q < c.size(); ++q) {
-      const int j = static_cast<int>((q / stride) % n);
+      const int j = static_cast<int>(((slab_.first_point() + q) / stride) % n);
       if (2 * j != n) p += grid_.wave_number(direction, j) * std::norm(c(q));
     }
-    return p;
+    return summed(p);
   }
 
   std::vector<tsi::ModelInvariant> invariants() const override {
@@ -399,7 +411,7 @@ class Nls final : public tsi::Model,
   // u' = -i |u|^2 u keeps |u| fixed pointwise: u -> u e^{-i |u|^2 t} on the grid.
   void nonlinear_flow(Real t, Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batch(1);
+    tsi::FieldTransforms& b = batch(1);
     auto w = b.data();
     w.col(0) = c;
     b.backward();
@@ -411,8 +423,8 @@ class Nls final : public tsi::Model,
   }
 
   Vector initial_value() const override {
-    Vector x(grid_.points());
-    grid_.for_each_point([&](Index p, const std::array<Real, 3>& at) {
+    Vector x(slab_.points());
+    tsi::for_each_slab_point(grid_, slab_, [&](Index p, const std::array<Real, 3>& at) {
       if (wave_) {
         x(p) = wave_->at(at);
         return;
@@ -438,18 +450,19 @@ class Nls final : public tsi::Model,
     return {x0 * std::polar(Real(1), -frequency * t), std::max(rounding, 4.0 * rounding * std::abs(frequency * t))};
   }
 
-  Index physical_dim() const override { return grid_.points(); }
+  Index physical_dim() const override { return slab_.points(); }
   std::vector<Index> physical_shape() const override { return {grid_.shape().begin(), grid_.shape().end()}; }
 
-  // Grid samples -> c = (2 pi)^{d/2} / N * forward(samples).
+  // Grid samples -> c = (2 pi)^{d/2} / N * forward(samples). A split run's process takes the
+  // whole grid's samples (a u0 file) or its slab's.
   Vector from_physical(const Vector& x) const override {
-    if (x.size() != grid_.points())
+    if (x.size() != grid_.points() && x.size() != slab_.points())
       throw tsi::ConfigError("model.u0", "got " + std::to_string(x.size()) + " samples, expected " +
                                              std::to_string(grid_.points()) + " (the grid " + grid_.describe() + ")");
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batch(1);
+    tsi::FieldTransforms& b = batch(1);
     auto w = b.data();
-    w.col(0) = x;
+    w.col(0) = x.size() == slab_.points() ? x : Vector(x.segment(slab_.first_point(), slab_.points()));
     b.forward();
     Vector c = w.col(0) * (std::sqrt(volume_) / static_cast<Real>(grid_.points()));
     dealias(c);
@@ -459,7 +472,7 @@ class Nls final : public tsi::Model,
   // c -> grid samples u_j = backward(c)_j / (2 pi)^{d/2}.
   Vector to_physical(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
-    tsi::GridTransforms& b = batch(1);
+    tsi::FieldTransforms& b = batch(1);
     auto w = b.data();
     w.col(0) = c;
     b.backward();
@@ -468,14 +481,14 @@ class Nls final : public tsi::Model,
 
   // Discrete L2 norm of grid samples.
   Real error_norm(const Vector& x) const override {
-    return std::sqrt(volume_ / static_cast<Real>(grid_.points())) * x.norm();
+    return std::sqrt(volume_ / static_cast<Real>(grid_.points()) * summed(x.squaredNorm()));
   }
 
  private:
   // The transforms for batches of `columns` states, planned on first use and kept: a run
   // sees two or three batch sizes (1 and N_tau), so nothing is planned inside a step after
   // the first call. Callers hold mutex_.
-  tsi::GridTransforms& batch(Index columns) const { return batches_.get(columns); }
+  tsi::FieldTransforms& batch(Index columns) const { return batches_.get(columns); }
 
   // Columns a batched call transforms at once: a large batch (a run's tau grid) goes through
   // the transforms a slice at a time, so the model's work space is a slice of the state: 32
@@ -489,6 +502,8 @@ class Nls final : public tsi::Model,
   }
 
   Real point_count() const { return static_cast<Real>(grid_.points()); }
+  // A sum over the processes of a split run (itself on one).
+  Real summed(Real local) const { return split_ ? split_->sum(local) : local; }
 
   // With the 2/3 rule, the modes outside its band set to zero (columns of coefficients).
   template <class Columns>
@@ -503,12 +518,15 @@ class Nls final : public tsi::Model,
   }
 
   tsi::SpectralGrid grid_;
+  tsi::GridSlab slab_;               // the points held here: the whole grid but in a split run
+  const tsi::Collective* split_;     // the processes of tsi run --split, or null
+  tsi::RealVector laplacian_;        // |m|^2 on the slab
   std::optional<tsi::PlaneWave> wave_;
   tsi::RealVector dealias_;    // the 2/3 rule's mask, or empty
   Real volume_;              // (2 pi)^d
   mutable std::mutex mutex_;   // the batches' buffers and phases_ are shared work space
   mutable tsi::GridTransformsPool batches_;
-  mutable Phases phases_{grid_};
+  mutable Phases phases_{grid_, slab_};
 };
 
 void register_nls(tsi::Registry& registry) {
@@ -531,7 +549,8 @@ void register_nls(tsi::Registry& registry) {
   entry.create = [](const tsi::Params& p) {
     std::vector<int> shape = tsi::spectral_grid_shape(p);
     const std::optional<tsi::PlaneWave> wave = tsi::plane_wave(p, shape);
-    return std::make_unique<Nls>(p.number("eps"), std::move(shape), wave, p.boolean("dealias"), p.context().fft);
+    return std::make_unique<Nls>(p.number("eps"), std::move(shape), wave, p.boolean("dealias"), p.context().fft,
+                                 p.context().collective);
   };
   registry.add_model(std::move(entry));
 }

@@ -267,7 +267,7 @@ class VlasovPoisson2d final : public tsi::Model,
     if (collective_) collective_->sum(&squares, 1);
     return std::sqrt(squares);
   }
-  bool split_across_processes() const override { return collective_ != nullptr; }
+  const tsi::Collective* processes() const override { return collective_; }
   // The state files keep positions in the box (a run carries them out unwrapped, and a file
   // farther out than a box length would be refused by check_positions).
   void canonicalize_physical(Vector& x) const override {
