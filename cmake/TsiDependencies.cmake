@@ -39,6 +39,17 @@ if(TSI_WITH_MPI AND NOT MPI_CXX_FOUND)
   message(FATAL_ERROR "TSI_WITH_MPI is ON but no MPI was found (Debian: apt-get install libopenmpi-dev openmpi-bin)")
 endif()
 message(STATUS "tsi: MPI studies ${TSI_WITH_MPI}")
+# HDF5 (optional: Debian's libhdf5-dev, serial): output.fields_every writes a grid model's fields
+# as HDF5 with an XDMF sidecar for ParaView (apps/tsi/field_snapshots.cpp). A split run's fields
+# are gathered on rank 0, which writes them: a snapshot is the physical field, n_tau times
+# smaller than the state vectors the ranks share. Without HDF5, output.fields_every is refused.
+pkg_check_modules(HDF5 QUIET IMPORTED_TARGET hdf5)
+option(TSI_WITH_HDF5 "Write field snapshots in HDF5 + XDMF (output.fields_every)" ${HDF5_FOUND})
+if(TSI_WITH_HDF5 AND NOT HDF5_FOUND)
+  message(FATAL_ERROR "TSI_WITH_HDF5 is ON but no HDF5 was found (Debian: apt-get install libhdf5-dev)")
+endif()
+message(STATUS "tsi: HDF5 field snapshots ${TSI_WITH_HDF5}")
+
 # FFTW's MPI transforms (Debian's libfftw3-mpi-dev: libfftw3_mpi, libfftw3l_mpi), with MPI: a
 # split run's spectral grid in slabs over the ranks (tsi run --split; apps/tsi/split_processes.cpp).
 if(TSI_WITH_MPI AND NOT TSI_PRECISION STREQUAL "quad")  # a quad build never splits

@@ -15,6 +15,7 @@
 
 #include "config.hpp"
 #include "dense_output.hpp"
+#include "field_snapshots.hpp"
 #include "interrupt.hpp"
 #include "run_recorder.hpp"
 #include "tsi/assembly.hpp"
@@ -635,6 +636,17 @@ RunPlan plan_run(const Json& config, const Registry& registry, const RunSettings
 
   const auto& rconf = config["reformulation"];
   if (settings.context.collective) check_split_run(config, assembly, registry);  // tsi run --split
+  if (const long every = config.contains("output") ? config["output"].value("fields_every", 0L) : 0L; every > 0) {
+    if (model.grid_fields().names.empty())
+      throw ConfigError("output.fields_every",
+                        fmt::format("got {}, but the model \"{}\" has no fields on a grid to write; expected 0, or a "
+                                    "grid model (nls, klein-gordon-complex)",
+                                    every, assembly.model_entry->info.name));
+    if (!FieldSnapshots::available())
+      throw ConfigError("output.fields_every", fmt::format("got {}, but this tsi was built without HDF5; install "
+                                                           "libhdf5-dev and rebuild (cmake finds it by itself)",
+                                                           every));
+  }
   const int data_needed = assembly.traits.data_order_for(assembly.model_entry->linear_remainder);
   if (rconf.contains("initial_data_order") && rconf["initial_data_order"].get<int>() < data_needed) {
     plan.warnings.push_back(fmt::format(
@@ -691,12 +703,27 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   RunRecorder recorder(*model, *reformulation, u0, config, outcome.csv_file);
   recorder.split_over(split);
   // A state of the whole run: a split run's shares gathered on rank 0 (empty elsewhere).
-  const auto whole = [split, complex = model->is_complex()](const Vector& local) -> Vector {
+  // A grid model's fields (u, then v) are each split in slabs: rank r's share is its slab of
+  // every field, and the whole state each field's slabs in rank order.
+  const auto whole = [split, complex = model->is_complex(),
+                      parts = std::max<Index>(1, static_cast<Index>(model->grid_fields().names.size()))](
+                         const Vector& local) -> Vector {
     if (!split) return local;
     Vector all = split->gather(local.real()).cast<Complex>();
     if (complex) all.imag() = split->gather(local.imag());
-    return all;
+    if (parts == 1 || all.size() == 0) return all;
+    const Index share = local.size() / parts, processes = split->size();  // equal slabs (tsi::grid_slab)
+    Vector ordered(all.size());
+    for (Index r = 0; r < processes; ++r)
+      for (Index f = 0; f < parts; ++f)
+        ordered.segment((f * processes + r) * share, share) = all.segment((r * parts + f) * share, share);
+    return ordered;
   };
+  // output.fields_every: the fields as HDF5 + XDMF (rank 0 of a split run writes what all gather).
+  const long fields_every = config.contains("output") ? config["output"].value("fields_every", 0L) : 0L;
+  std::optional<FieldSnapshots> snapshots;
+  if (fields_every > 0 && !stream_dir.empty())
+    snapshots.emplace(stream_dir, model->grid_fields(), model->is_complex());
   // u between the steps (output.times), from the scheme's states interpolated in t.
   std::unique_ptr<DenseOutput> dense;
   if (std::vector<double> times = checked_output_times(config); !times.empty())
@@ -751,6 +778,11 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
         return false;
       }
       if (progress && progress_clock.tick()) progress({"run", n, n_steps, to_double(t), t_end});
+      if (go_on && fields_every > 0 && (split || snapshots) && (n % fields_every == 0 || n == n_steps)) {
+        const device::HostView host(state);
+        const Vector x = whole(model->to_physical(reformulation->read_back(state, t)));
+        if (snapshots) snapshots->write(n, to_double(t), x);
+      }
       if (go_on && state_every > 0 && (split || !stream_dir.empty()) && (n % state_every == 0 || n == n_steps)) {
         // The state as a file a run can start from (written to a temporary file, then renamed),
         // and result.json's checkpoint says at which time it is.
@@ -818,6 +850,9 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   const Vector x_here = model->to_physical(recorder.u_last());
   const Vector x = whole(x_here);
   if (split) result["split"] = {{"processes", split->size()}, {"memory", "rank 0's"}};
+  if (snapshots)
+    result["fields"] = {{"file", "fields.h5"}, {"xdmf", "fields.xmf"}, {"every", fields_every},
+                        {"snapshots", snapshots->count()}};
   if (dense) {
     dense->finish();
     outcome.output_times = dense->times();

@@ -96,6 +96,8 @@ std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
   if (outcome.u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, u_final_file);
   if (outcome.reference_u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, reference_u_final_file);
   if (!outcome.u_times.empty() && outcome.u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, u_times_file);
+  if (r.contains("fields"))
+    s += fmt::format(", {0}/fields.h5 and {0}/fields.xmf ({1} snapshots)", out_dir, r["fields"]["snapshots"].get<long>());
   s += "\n";
   return s;
 }

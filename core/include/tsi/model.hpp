@@ -12,6 +12,16 @@ namespace tsi {
 
 class Collective;
 
+/// The fields on a periodic grid that a model's physical state is made of: `names` (nls: u;
+/// klein-gordon-complex: u, then v), one after the other, each `shape` in C order on the box
+/// [0, lengths[i]) per direction. output.fields_every writes them for ParaView (HDF5 and XDMF),
+/// and each process of a split run holds a slab of every one. Empty names: not a grid's fields.
+struct GridFields {
+  std::vector<std::string> names;
+  std::vector<Index> shape;
+  std::vector<double> lengths;
+};
+
 /// The general class u' = (1/eps) A u + R u + f(t, u) (SPEC.md section 7). A model gives a
 /// small required core: its size, whether it is complex, the action of e^{A tau}
 /// (2 pi-periodic) and f, on batches (one state per column, so that the two-scale
@@ -85,6 +95,8 @@ class TSI_API Model {
   /// 2-D or 3-D grid; the runner refuses to split any other model.
   virtual const Collective* processes() const { return nullptr; }
   bool split_across_processes() const { return processes() != nullptr; }
+  /// The fields on a grid the physical state is made of (none by default).
+  virtual GridFields grid_fields() const { return {}; }
   /// Physical variables as a state file keeps them for a run to start from (state.npy): a
   /// periodic model's positions brought into its box. Unchanged by default.
   virtual void canonicalize_physical(Vector& /*x*/) const {}

@@ -175,6 +175,9 @@ class Nls final : public tsi::Model,
 
   Index dim() const override { return slab_.points(); }
   const tsi::Collective* processes() const override { return split_; }
+  tsi::GridFields grid_fields() const override {
+    return {{"u"}, physical_shape(), std::vector<double>(static_cast<std::size_t>(grid_.dims()), tsi::to_double(tsi::two_pi))};
+  }
   bool is_complex() const override { return true; }
 
   const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
