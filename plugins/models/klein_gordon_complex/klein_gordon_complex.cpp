@@ -41,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "tsi/collective.hpp"
 #include "tsi/error.hpp"
 #include "tsi/model.hpp"
 #include "tsi/phase.hpp"
@@ -65,11 +66,15 @@ class KleinGordonComplex final : public tsi::Model,
                                  public tsi::PhysicalVariables,
                                  public tsi::SecondOrderForm {
  public:
+  // split: the processes of tsi run --split, each holding a slab of the grid (tsi::grid_slab) of
+  // u and of v, or null for the whole grid here.
   KleinGordonComplex(Real eps, std::vector<int> shape, Real lambda, Data data, Real length,
-                     tsi::ThreadLimit fftw_threads)
+                     tsi::ThreadLimit fftw_threads, const tsi::Collective* split)
       : Model(eps),
         grid_(std::move(shape)),
-        n_(grid_.points()),
+        slab_(tsi::grid_slab(grid_, split)),
+        split_(split),
+        n_(slab_.points()),
         lambda_(lambda),
         data_(data),
         length_(length),
@@ -77,18 +82,13 @@ class KleinGordonComplex final : public tsi::Model,
         a_(n_),
         inverse_a_(n_),
         remainder_(2 * n_),
-        minus_(static_cast<std::size_t>(n_)),
-        batches_(grid_, fftw_threads) {
+        batches_(grid_, fftw_threads, split) {
     for (Index j = 0; j < n_; ++j) {
-      const Real k2 = grid_.laplacian_symbol()(j) * std::pow(tsi::two_pi / length_, 2);  // (2 pi k / L)^2
+      const Real k2 = grid_.laplacian_symbol()(slab_.first_point() + j) * std::pow(tsi::two_pi / length_, 2);  // (2 pi k / L)^2
       const Real root = std::sqrt(1.0 + eps * k2);
       a_(j) = std::sqrt(root);
       inverse_a_(j) = 1.0 / a_(j);
       remainder_(j) = remainder_(n_ + j) = k2 / (1.0 + root);
-    }
-    for (const auto& [m, minus_m] : grid_.half_to_full()) {
-      minus_[static_cast<std::size_t>(m)] = minus_m;
-      minus_[static_cast<std::size_t>(minus_m)] = m;
     }
   }
   using Model::linear_flow;
@@ -96,6 +96,11 @@ class KleinGordonComplex final : public tsi::Model,
 
   Index dim() const override { return 2 * n_; }
   bool is_complex() const override { return true; }
+  const tsi::Collective* processes() const override { return split_; }
+  tsi::GridFields grid_fields() const override {
+    return {{"u", "v"}, {grid_.shape().begin(), grid_.shape().end()},
+            std::vector<double>(static_cast<std::size_t>(grid_.dims()), tsi::to_double(length_))};
+  }
   const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
   const tsi::PhysicalVariables* physical_variables() const override { return this; }
   const tsi::ExactNonlinearFlow* exact_nonlinear_flow() const override { return this; }
@@ -134,21 +139,24 @@ class KleinGordonComplex final : public tsi::Model,
   Real H1(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
     const Matrix z = field_z(c);
-    return lambda_ / 2 * volume_ / point_count() * z.array().abs2().square().sum();
+    return lambda_ / 2 * volume_ / point_count() * summed(z.array().abs2().square().sum());
   }
 
-  // Q = Im int conj(z) eps z_t = (2 pi)^d sum_k Im(conj(z_k) (eps z_t)_k) (Parseval), with the
-  // coefficients z_k = (u_k + conj(v_{-k})) / 2 and (eps z_t)_k = a_k^2 (conj(v_{-k}) - u_k) / (2 i).
+  // Q = Im int conj(z) eps z_t = L^d / N sum_j Im(conj(z_j) (eps z_t)_j) on the grid, with
+  // z = (u + conj v) / 2 and eps z_t = <D> (conj v - u) / (2 i) (<D> in Fourier). On the grid, not
+  // in Fourier: v's coefficient of -k, which conj v needs, lies on another process's slab.
   Real charge(const Vector& c) const {
+    const Vector uv = to_physical(c);
+    std::lock_guard<std::mutex> lock(mutex_);
+    const Vector u = uv.head(n_), conj_v = uv.tail(n_).conjugate();
+    tsi::FieldTransforms& b = batches_.get(1);
+    b.data().col(0) = (conj_v - u) / Complex(0, 2);
+    b.forward();
+    b.data().col(0) = a_.array().square().matrix().cwiseProduct(b.data().col(0)) / point_count();
+    b.backward();
     Real q = 0;
-    const Real scale = 1 / std::sqrt(volume_);
-    for (Index k = 0; k < n_; ++k) {
-      const Complex u = scale * inverse_a_(k) * c(k);
-      const Complex cv = std::conj(scale * inverse_a_(k) * c(n_ + minus_[static_cast<std::size_t>(k)]));
-      const Complex z = (u + cv) / Real(2), p = a_(k) * a_(k) * (cv - u) / Complex(0, 2);
-      q += (std::conj(z) * p).imag();
-    }
-    return volume_ * q;
+    for (Index j = 0; j < n_; ++j) q += (std::conj((u(j) + conj_v(j)) / Real(2)) * b.data()(j, 0)).imag();
+    return volume_ / point_count() * summed(q);
   }
 
   std::vector<tsi::ModelInvariant> invariants() const override {
@@ -159,7 +167,7 @@ class KleinGordonComplex final : public tsi::Model,
   Vector initial_value() const override {
     Vector uv(2 * n_);
     Vector z(n_), p(n_);
-    grid_.for_each_point([&](Index j, const std::array<Real, 3>& x) {
+    tsi::for_each_slab_point(grid_, slab_, [&](Index j, const std::array<Real, 3>& x) {
       Complex zz = 1, pp = 1;
       for (int i = 0; i < grid_.dims(); ++i) {
         const Real xi = x[static_cast<std::size_t>(i)] * (length_ / tsi::two_pi);  // in [0, L)
@@ -195,12 +203,17 @@ class KleinGordonComplex final : public tsi::Model,
     for (const int n : grid_.shape()) shape.push_back(n);
     return shape;
   }
+  // A split run's process takes the whole grid's samples (a u0 file) or its slabs'.
   Vector from_physical(const Vector& uv) const override {
-    if (uv.size() != 2 * n_)
+    const Index whole = grid_.points();
+    if (uv.size() != 2 * whole && uv.size() != 2 * n_)
       throw tsi::ConfigError("model.u0", "got " + std::to_string(uv.size()) + " samples, expected " +
-                                             std::to_string(2 * n_) + ": u, then v, on the grid " + grid_.describe());
+                                             std::to_string(2 * whole) + ": u, then v, on the grid " + grid_.describe());
     std::lock_guard<std::mutex> lock(mutex_);
-    return from_samples(uv);
+    if (uv.size() == 2 * n_) return from_samples(uv);
+    Vector mine(2 * n_);
+    mine << uv.segment(slab_.first_point(), n_), uv.segment(whole + slab_.first_point(), n_);
+    return from_samples(mine);
   }
   Vector to_physical(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -213,7 +226,9 @@ class KleinGordonComplex final : public tsi::Model,
     }
     return uv;
   }
-  Real error_norm(const Vector& uv) const override { return std::sqrt(volume_ / point_count()) * uv.norm(); }
+  Real error_norm(const Vector& uv) const override {
+    return std::sqrt(volume_ / point_count() * summed(uv.squaredNorm()));
+  }
 
   // ---- The second-order form: z_k'' = -omega_k^2 z_k - (lambda / eps) (|z|^2 z)_k --------------
   // omega_k = sqrt(1 + eps |k|^2) / eps, for the Fourier coefficients z_k = forward(z)_k / N; the
@@ -270,7 +285,10 @@ class KleinGordonComplex final : public tsi::Model,
   }
 
  private:
-  Real point_count() const { return static_cast<Real>(n_); }
+  // N, the whole grid's points (the transforms' normalisation).
+  Real point_count() const { return static_cast<Real>(grid_.points()); }
+  // A sum over the processes of a split run (itself on one).
+  Real summed(Real local) const { return split_ ? split_->sum(local) : local; }
 
   // c from the samples (u, v): c_u = (2 pi)^{d/2} / N a forward(u). Callers hold mutex_.
   Vector from_samples(const Vector& uv) const {
@@ -321,7 +339,9 @@ class KleinGordonComplex final : public tsi::Model,
   }
 
   tsi::SpectralGrid grid_;
-  Index n_;  // grid points, N
+  tsi::GridSlab slab_;            // the points held here: the whole grid but in a split run
+  const tsi::Collective* split_;  // the processes of tsi run --split, or null
+  Index n_;                       // the points held here (N on one process)
   Real lambda_;
   Data data_;
   Real length_;                // the torus's period L in each direction
@@ -329,7 +349,6 @@ class KleinGordonComplex final : public tsi::Model,
   tsi::RealVector a_;          // (1 + eps |k|^2)^{1/4}
   tsi::RealVector inverse_a_;  // its inverse
   tsi::RealVector remainder_;  // A_k on u's and on v's coefficients
-  std::vector<Index> minus_;   // the index of -k
   mutable std::mutex mutex_;   // the transforms' buffers are shared work space
   mutable tsi::GridTransformsPool batches_;
 };
@@ -368,7 +387,8 @@ void register_klein_gordon_complex(tsi::Registry& registry) {
                       : name == "bao-dong"   ? Data::bao_dong
                                              : Data::cos_sin;
     return std::make_unique<KleinGordonComplex>(p.number("eps"), std::move(shape), p.number("lambda"), data,
-                                                static_cast<Real>(p.number("length")), p.context().fft);
+                                                static_cast<Real>(p.number("length")), p.context().fft,
+                                                p.context().collective);
   };
   registry.add_model(std::move(entry));
 }
