@@ -197,7 +197,7 @@ void register_composition(tsi::Registry& registry) {
   entry.create = [reg](const tsi::Params& p) {
     const Json& raw = p.raw();
     const tsi::SchemeEntry& base = base_entry(*reg, raw);
-    return std::make_unique<CompositionScheme>(base.create(tsi::Params(base_params(raw))),
+    return std::make_unique<CompositionScheme>(base.create(tsi::Params(base_params(raw), p.context())),
                                                method_named(raw.value("method", std::string("triple-jump"))));
   };
   registry.add_scheme(std::move(entry));
