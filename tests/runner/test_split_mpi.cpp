@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "run_command.hpp"
+#include "split_run.hpp"
 #include "tsi/npy.hpp"
 
 namespace t = tsi::test;
@@ -20,52 +21,6 @@ namespace t = tsi::test;
 namespace {
 
 constexpr double pi_over_16 = 0.19634954084936207;  // the peer's step
-
-t::CommandResult split_run(int ranks, const std::vector<std::string>& args) {
-  t::CommandEnv env = t::mpirun_env();
-  env.send_signal = SIGTERM;  // a guard: the runs take a second; a hung mpirun is stopped
-  env.signal_after_seconds = 300.0;
-  std::vector<std::string> all = {"-np", std::to_string(ranks), "--oversubscribe", "--allow-run-as-root",
-                                  TSI_TEST_RUNNER, "run"};
-  all.insert(all.end(), args.begin(), args.end());
-  all.push_back("--split");
-  t::CommandResult r = t::run_command(TSI_TEST_MPIEXEC, all, env);
-  // Once in a CI run, mpirun exited 1 within 0.03 s while another test launched mpirun, before
-  // any rank had written a word: Open MPI's launcher, not tsi. Such a launch (nothing from tsi on
-  // either stream) is tried once more, and said; anything tsi printed is judged as it is.
-  // tsi speaks first in "tsi: " (an error) or a line starting "tsi " (a run's header); mpirun's
-  // own messages may name the runner's path, which also holds "tsi".
-  const bool tsi_spoke = r.err.find("tsi: ") != std::string::npos || r.out.rfind("tsi ", 0) == 0 ||
-                         r.out.find("\ntsi ") != std::string::npos;
-  if (r.exit_code != 0 && !tsi_spoke) {
-    MESSAGE("mpirun failed to launch, tried again: " << r.describe());
-    r = t::run_command(TSI_TEST_MPIEXEC, all, env);
-  }
-  return r;
-}
-
-// The largest difference of two arrays of .npy files, relative to the largest entry of the first.
-double relative_difference(const t::fs::path& a, const t::fs::path& b) {
-  const tsi::NpyArray x = tsi::read_npy(a.string()), y = tsi::read_npy(b.string());
-  REQUIRE(x.header.shape == y.header.shape);
-  return (x.values - y.values).cwiseAbs().maxCoeff() / x.values.cwiseAbs().maxCoeff();
-}
-
-// The numbers of invariants.csv's rows after the header.
-std::vector<std::vector<double>> csv_rows(const t::fs::path& file) {
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::stringstream cells(line);
-    std::string cell;
-    while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
-    rows.push_back(row);
-  }
-  return rows;
-}
 
 // A plasma of 2048 of the peer's particles (tests/data/uapic) on its 128 x 64 grid, 8 steps.
 t::Json particle_config(const std::string& scheme) {
@@ -105,14 +60,14 @@ TEST_CASE("split run: 1 process and mpirun -np 2 and 3 --split give the same par
     for (const int ranks : c.label == "peer" ? std::vector<int>{2, 3} : std::vector<int>{2}) {
       CAPTURE(ranks);
       const std::string out = dir / ("split" + std::to_string(ranks));
-      const t::CommandResult split = split_run(ranks, {config, "--out", out});
+      const t::CommandResult split = t::split_run(ranks, {config, "--out", out});
       REQUIRE_MESSAGE(split.exit_code == 0, split.describe());
       const t::Json record = t::read_json(t::fs::path(out) / "result.json");
       CHECK(record["split"]["processes"] == ranks);
-      CHECK(relative_difference(dir.path() / "one/u_final.npy", t::fs::path(out) / "u_final.npy") < 1e-13);
-      CHECK(relative_difference(dir.path() / "one/state.npy", t::fs::path(out) / "state.npy") < 1e-13);
+      CHECK(t::relative_difference(dir.path() / "one/u_final.npy", t::fs::path(out) / "u_final.npy") < 1e-13);
+      CHECK(t::relative_difference(dir.path() / "one/state.npy", t::fs::path(out) / "state.npy") < 1e-13);
       // Every recorded W, P, Q and W_E (the sums over the ranks), and the tau monitors.
-      const auto rows = csv_rows(dir.path() / "one/invariants.csv"), split_rows = csv_rows(t::fs::path(out) / "invariants.csv");
+      const auto rows = t::csv_rows(dir.path() / "one/invariants.csv"), split_rows = t::csv_rows(t::fs::path(out) / "invariants.csv");
       REQUIRE(rows.size() == split_rows.size());
       REQUIRE(rows.size() == 9);
       // (The change columns of P and Q are rounding, 1e-16 .. 1e-14: compared absolutely.)
@@ -149,7 +104,7 @@ TEST_CASE("split run: what cannot be split is refused on every rank, said once, 
                         Case{{config, "--out", dir / "times", "--set", "output.times=[0.5]"},
                              "output.times: dense output is not available under --split"}}) {
     CAPTURE(c.says);
-    const t::CommandResult r = split_run(3, c.args);
+    const t::CommandResult r = t::split_run(3, c.args);
     CHECK_MESSAGE(r.exit_code == 2, r.describe());
     const std::size_t first = r.err.find(c.says);
     REQUIRE_MESSAGE(first != std::string::npos, r.describe());
@@ -192,7 +147,7 @@ TEST_CASE("split run: SIGINT to mpirun stops every rank at one step, and rank 0 
   const long steps = record["steps"].get<long>();
   CHECK(steps > 0);
   CHECK(steps < 4000);
-  CHECK(csv_rows(dir.path() / "out/invariants.csv").size() == static_cast<std::size_t>(steps + 1));
+  CHECK(t::csv_rows(dir.path() / "out/invariants.csv").size() == static_cast<std::size_t>(steps + 1));
   CHECK(tsi::read_npy_header(dir / "out/u_final.npy").shape == std::vector<std::uint64_t>{2048, 4});
 }
 #endif
