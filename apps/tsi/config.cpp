@@ -110,9 +110,9 @@ const ParamSchema& output_schema() {
                     "(vlasov-poisson-2d: model.particles)")
           .check([](const Json& v) { return v.get<long>() >= 0; }, "a non-negative integer"),
       integer_param("fields_every", 0,
-                    "write the fields of a grid model (nls: u; klein-gordon-complex: u and v; |u|, Re u, Im u each) "
-                    "to fields.h5 every this many steps and at the first and last, with fields.xmf for ParaView "
-                    "(0: never)")
+                    "write the fields of a grid model (nls: u; klein-gordon: v; klein-gordon-complex: u and v; |u|, Re "
+                    "u, Im u each) to fields.h5 every this many steps and at the first and last, with fields.xmf for "
+                    "ParaView (0: never)")
           .check([](const Json& v) { return v.get<long>() >= 0; }, "a non-negative integer"),
       number_param("checkpoint_seconds", 30.0,
                    "rewrite result.json (status running, the time reached) at most this often while a run goes")

@@ -423,8 +423,8 @@ void check_split_run(const Json& config, const Assembly& assembly, const Registr
   const Model& model = *assembly.model;
   if (!model.split_across_processes())
     throw ConfigError("--split", fmt::format("the model \"{}\" does not split its state over processes; expected "
-                                             "a model that does (vlasov-poisson-2d: its particles; nls and "
-                                             "klein-gordon-complex on a 2-D or 3-D grid: slabs of it)",
+                                             "a model that does (vlasov-poisson-2d: its particles; nls, "
+                                             "klein-gordon and klein-gordon-complex on a 2-D or 3-D grid: slabs of it)",
                                              config["model"]["name"].get<std::string>()));
   if (assembly.traits.adaptive)
     throw ConfigError("scheme", fmt::format("\"{}\" chooses its steps from the state, which a split run holds in "
@@ -640,7 +640,7 @@ RunPlan plan_run(const Json& config, const Registry& registry, const RunSettings
     if (model.grid_fields().names.empty())
       throw ConfigError("output.fields_every",
                         fmt::format("got {}, but the model \"{}\" has no fields on a grid to write; expected 0, or a "
-                                    "grid model (nls, klein-gordon-complex)",
+                                    "grid model (nls, klein-gordon, klein-gordon-complex)",
                                     every, assembly.model_entry->info.name));
     if (!FieldSnapshots::available())
       throw ConfigError("output.fields_every", fmt::format("got {}, but this tsi was built without HDF5; install "

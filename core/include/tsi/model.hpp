@@ -91,8 +91,8 @@ class TSI_API Model {
   /// Collective) when the model holds only this process's share of the state, else null: its
   /// field and its own invariants then reduce over the processes, the core's inner products
   /// (I, m, the default error norm) reduce through it, and physical_shape() is the whole
-  /// state's. vlasov-poisson-2d's particles, and the slabs of nls and klein-gordon-complex on a
-  /// 2-D or 3-D grid; the runner refuses to split any other model.
+  /// state's. vlasov-poisson-2d's particles, and the slabs of nls, klein-gordon and
+  /// klein-gordon-complex on a 2-D or 3-D grid; the runner refuses to split any other model.
   virtual const Collective* processes() const { return nullptr; }
   bool split_across_processes() const { return processes() != nullptr; }
   /// The fields on a grid the physical state is made of (none by default).

@@ -65,6 +65,7 @@
 #include <string>
 #include <vector>
 
+#include "tsi/collective.hpp"
 #include "tsi/error.hpp"
 #include "tsi/model.hpp"
 #include "tsi/phase.hpp"
@@ -104,12 +105,16 @@ class KleinGordon final : public tsi::Model,
  public:
   // fftw_threads: FFTW's own threads for large batches (the run's tsi::Context::fft).
   // wave: the plane wave of model.initial = "plane-wave"; data: z and e^2 z_t of model.z0 and
-  // model.eps_z_t0; neither: the default data.
+  // model.eps_z_t0; neither: the default data. split: the processes of tsi run --split, each
+  // holding a slab of the grid (tsi::grid_slab), or null for the whole grid here.
   KleinGordon(Real eps, std::vector<int> shape, Real lambda, std::optional<tsi::PlaneWave> wave,
-              std::optional<FieldAndMomentum> data, tsi::ThreadLimit fftw_threads = {})
+              std::optional<FieldAndMomentum> data, tsi::ThreadLimit fftw_threads = {},
+              const tsi::Collective* split = nullptr)
       : Model(eps),
         grid_(std::move(shape)),
-        n_x_(grid_.points()),
+        slab_(tsi::grid_slab(grid_, split)),
+        split_(split),
+        n_x_(slab_.points()),
         wave_(wave),
         data_(std::move(data)),
         lambda_(lambda),
@@ -117,11 +122,11 @@ class KleinGordon final : public tsi::Model,
         inverse_a_(n_x_),
         remainder_(n_x_),
         fftw_threads_(fftw_threads),
-        full_to_half_(grid_.full_to_half()),
-        half_to_full_(grid_.half_to_full()),
-        batches_(grid_, fftw_threads) {
+        full_to_half_(split ? std::vector<tsi::SpectralGrid::HalfIndex>() : grid_.full_to_half()),
+        half_to_full_(split ? std::vector<std::array<Index, 2>>() : grid_.half_to_full()),
+        batches_(grid_, fftw_threads, split) {
     for (Index j = 0; j < n_x_; ++j) {
-      const Real k2 = grid_.laplacian_symbol()(j);  // |k|^2, the Nyquist index as +n/2
+      const Real k2 = grid_.laplacian_symbol()(slab_.first_point() + j);  // |k|^2, the Nyquist index as +n/2
       const Real root = std::sqrt(1.0 + eps * k2);
       inverse_a_(j) = 1.0 / std::sqrt(root);
       remainder_(j) = k2 / (1.0 + root);
@@ -133,6 +138,10 @@ class KleinGordon final : public tsi::Model,
 
   Index dim() const override { return n_x_; }
   bool is_complex() const override { return true; }
+  const tsi::Collective* processes() const override { return split_; }
+  tsi::GridFields grid_fields() const override {
+    return {{"v"}, physical_shape(), std::vector<double>(static_cast<std::size_t>(grid_.dims()), tsi::to_double(tsi::two_pi))};
+  }
 
   const tsi::HamiltonianStructure* hamiltonian() const override { return this; }
   const tsi::FusedTauGrid* fused_tau_grid() const override { return this; }
@@ -150,11 +159,13 @@ class KleinGordon final : public tsi::Model,
   // i lambda sqrt(2 pi) / n_x a^{-1} forward(z^3), z = Re backward(a^{-1} c) / sqrt(2 pi).
   void nonlinear_field(ConstMatrixRef c, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (split_) return slab_field<false>(Phases{}, batch(c.cols()), c, out);
     fused_field<false>(Phases{}, real_batch(c.cols()), c, out);
   }
 
   void filtered_field(const tsi::RealVector& taus, MatrixRef c, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (split_) return slab_field<true>(Phases(taus), batch(c.cols()), c, out);
     fused_field<true>(Phases(taus), real_batch(c.cols()), c, out);
   }
 
@@ -162,21 +173,30 @@ class KleinGordon final : public tsi::Model,
   // work space).
   class GridField final : public tsi::TauGridField {
    public:
-    GridField(const KleinGordon& model, const tsi::RealVector& taus)
-        : model_(model), phases_(taus), batch_(model.grid_, taus.size(), model.fftw_threads_) {}
-    void evaluate(MatrixRef c, MatrixRef out) override { model_.fused_field<true>(phases_, batch_, c, out); }
+    GridField(const KleinGordon& model, const tsi::RealVector& taus) : model_(model), phases_(taus) {
+      if (model.split_)
+        slab_ = tsi::make_field_transforms(model.grid_, taus.size(), model.fftw_threads_, model.split_);
+      else
+        batch_ = std::make_unique<tsi::RealGridTransforms>(model.grid_, taus.size(), model.fftw_threads_);
+    }
+    void evaluate(MatrixRef c, MatrixRef out) override {
+      if (slab_) return model_.slab_field<true>(phases_, *slab_, c, out);
+      model_.fused_field<true>(phases_, *batch_, c, out);
+    }
 
    private:
     const KleinGordon& model_;
     Phases phases_;
-    tsi::RealGridTransforms batch_;
+    std::unique_ptr<tsi::RealGridTransforms> batch_;  // one process: real transforms
+    std::unique_ptr<tsi::FieldTransforms> slab_;      // a split run: its slabs' complex transforms
   };
 
   std::unique_ptr<tsi::TauGridField> bind_tau_grid(const tsi::RealVector& taus) const override {
     return std::make_unique<GridField>(*this, taus);
   }
-  // Each binding owns its tables and transforms: bindings may run on different threads.
-  bool independent_tau_grid_bindings() const override { return true; }
+  // Each binding owns its tables and transforms: bindings may run on different threads, but
+  // not in a split run, whose transforms are collective (every process in the same order).
+  bool independent_tau_grid_bindings() const override { return !split_; }
 
   // f_tau(c) = e^{-i tau} N(e^{i tau} c) in one pass each way, in real transforms. Since e^{JM tau}
   // is the scalar e^{i tau}, backward(a^{-1} e^{i tau} c) = e^{i tau} g with g = backward(a^{-1} c):
@@ -207,11 +227,50 @@ class KleinGordon final : public tsi::Model,
     }
   }
 
+  // fused_field on a split run's slabs: the -m of a coefficient lies on another process's slab,
+  // so there is no half spectrum to take; z = Re(backward(e^{i tau} a^{-1} c)) pointwise instead,
+  // in complex transforms (twice the work of the real ones, the same numbers to rounding).
+  template <bool Rotate>
+  void slab_field(const Phases& phases, tsi::FieldTransforms& b, ConstMatrixRef c, MatrixRef out) const {
+    const Index cols = c.cols();
+    auto w = b.data();
+    for (Index j = 0; j < cols; ++j) {
+      const Complex turn = Rotate ? Complex(phases.cos(j), phases.sin(j)) : Complex(1.0, 0.0);  // e^{i tau}
+      for (Index m = 0; m < n_x_; ++m) w(m, j) = inverse_a_(m) * times(c(m, j), turn);
+    }
+    b.backward();
+    const Real scale = lambda_ / (volume_ * point_count());
+    for (Index j = 0; j < cols; ++j)
+      for (Index p = 0; p < n_x_; ++p) {
+        const Real z = w(p, j).real();
+        w(p, j) = Complex(scale * z * z * z, 0.0);
+      }
+    b.forward();
+    for (Index j = 0; j < cols; ++j) {
+      const Complex turn = Rotate ? Complex(phases.sin(j), phases.cos(j)) : Complex(0.0, 1.0);  // i e^{-i tau}
+      for (Index m = 0; m < n_x_; ++m) out(m, j) = inverse_a_(m) * times(w(m, j), turn);
+    }
+  }
+
   // D(J grad H1)(c) d = i lambda (2 pi)^{d/2} / N a^{-1} forward(3 z^2 dz), dz the real part of
   // backward(a^{-1} d) / (2 pi)^{d/2}: same scaling as the field.
   void nonlinear_field_derivative(ConstMatrixRef c, ConstMatrixRef d, MatrixRef out) const override {
     std::lock_guard<std::mutex> lock(mutex_);
     const Index cols = c.cols();
+    if (split_) {  // in complex transforms, as slab_field
+      tsi::FieldTransforms& b = batch(cols);
+      auto w = b.data();
+      w = inverse_a_.asDiagonal() * c;
+      b.backward();
+      const tsi::RealMatrix z = w.real();
+      w = inverse_a_.asDiagonal() * d;
+      b.backward();
+      const Real scale = 3.0 * lambda_ / (volume_ * point_count());
+      w = (scale * z.array().square() * w.real().array()).matrix().cast<Complex>();
+      b.forward();
+      out = Complex(0.0, 1.0) * (inverse_a_.asDiagonal() * w);
+      return;
+    }
     tsi::RealGridTransforms& b = real_batch(cols);
     const Complex one(1.0, 0.0);
     for (Index j = 0; j < cols; ++j) hermitian_part(c.col(j), false, one, b.spectrum().col(j));
@@ -233,6 +292,12 @@ class KleinGordon final : public tsi::Model,
   // (lambda / 4) (2 pi / n_x) sum z_j^4 with z_j = Re backward(a^{-1} c)_j / sqrt(2 pi).
   Real H1(const Vector& c) const override {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (split_) {
+      tsi::FieldTransforms& b = batch(1);
+      b.data().col(0) = inverse_a_.cwiseProduct(c);
+      b.backward();
+      return lambda_ * summed(b.data().col(0).real().array().pow(4).sum()) / (4.0 * volume_ * point_count());
+    }
     tsi::RealGridTransforms& b = real_batch(1);
     hermitian_part(c, false, Complex(1.0, 0.0), b.spectrum().col(0));
     b.backward();
@@ -252,7 +317,7 @@ class KleinGordon final : public tsi::Model,
   Vector initial_value() const override {
     if (data_) return from_field_and_momentum(*data_);
     Vector v(n_x_);
-    grid_.for_each_point([&](Index j, const std::array<Real, 3>& x) {
+    tsi::for_each_slab_point(grid_, slab_, [&](Index j, const std::array<Real, 3>& x) {
       if (wave_) {
         v(j) = wave_->at(x);
         return;
@@ -284,15 +349,16 @@ class KleinGordon final : public tsi::Model,
   Index physical_dim() const override { return n_x_; }
   std::vector<Index> physical_shape() const override { return {grid_.shape().begin(), grid_.shape().end()}; }
 
-  // Grid samples of v -> c = sqrt(2 pi) / n_x * a forward(v).
+  // Grid samples of v -> c = sqrt(2 pi) / n_x * a forward(v). A split run's process takes the
+  // whole grid's samples (a u0 file) or its slab's.
   Vector from_physical(const Vector& v) const override {
-    if (v.size() != n_x_)
+    if (v.size() != grid_.points() && v.size() != n_x_)
       throw tsi::ConfigError("model.u0", "got " + std::to_string(v.size()) + " samples, expected " +
-                                             std::to_string(n_x_) + " (the grid " + grid_.describe() + ")");
+                                             std::to_string(grid_.points()) + " (the grid " + grid_.describe() + ")");
     std::lock_guard<std::mutex> lock(mutex_);
     tsi::FieldTransforms& b = batch(1);
     auto w = b.data();
-    w.col(0) = v;
+    w.col(0) = v.size() == n_x_ ? v : Vector(v.segment(slab_.first_point(), n_x_));
     b.forward();
     return (std::sqrt(volume_) / point_count()) * w.col(0).cwiseQuotient(inverse_a_.cast<Complex>());
   }
@@ -303,10 +369,13 @@ class KleinGordon final : public tsi::Model,
     std::lock_guard<std::mutex> lock(mutex_);
     tsi::FieldTransforms& b = batch(1);
     auto w = b.data();
-    w.col(0) = data.z.cast<Complex>();
+    const auto mine = [&](const tsi::RealVector& x) {  // this process's slab of a whole grid's values
+      return x.size() == n_x_ ? x : tsi::RealVector(x.segment(slab_.first_point(), n_x_));
+    };
+    w.col(0) = mine(data.z).cast<Complex>();
     b.forward();
     const Vector q_hat = w.col(0);
-    w.col(0) = data.p.cast<Complex>();
+    w.col(0) = mine(data.p).cast<Complex>();
     b.forward();
     const Vector c = q_hat.cwiseQuotient(inverse_a_.cast<Complex>()) -
                      Complex(0.0, 1.0) * w.col(0).cwiseProduct(inverse_a_.cast<Complex>());
@@ -333,7 +402,7 @@ class KleinGordon final : public tsi::Model,
   tsi::RealVector frequencies() const override {
     tsi::RealVector omega(2 * n_x_);
     for (Index j = 0; j < n_x_; ++j)
-      omega(j) = omega(n_x_ + j) = std::sqrt(1.0 + eps() * grid_.laplacian_symbol()(j)) / eps();
+      omega(j) = omega(n_x_ + j) = std::sqrt(1.0 + eps() * grid_.laplacian_symbol()(slab_.first_point() + j)) / eps();
     return omega;
   }
   // z = Re v and (1 - e^2 lap)^{-1/2} p = -Im v on the grid; p_k = a_k^2 (that)_k.
@@ -382,7 +451,9 @@ class KleinGordon final : public tsi::Model,
   }
 
   // Discrete L2 norm of grid samples.
-  Real error_norm(const Vector& v) const override { return std::sqrt(volume_ / point_count()) * v.norm(); }
+  Real error_norm(const Vector& v) const override {
+    return std::sqrt(volume_ / point_count() * summed(v.squaredNorm()));
+  }
 
  private:
   // The transforms for batches of `columns` states, planned on first use and kept. Callers
@@ -422,7 +493,10 @@ class KleinGordon final : public tsi::Model,
       out(m) = inverse_a_(m) * times(f, turn);
     }
   }
-  Real point_count() const { return static_cast<Real>(n_x_); }
+  // N, the whole grid's points (the transforms' normalisation).
+  Real point_count() const { return static_cast<Real>(grid_.points()); }
+  // A sum over the processes of a split run (itself on one).
+  Real summed(Real local) const { return split_ ? split_->sum(local) : local; }
 
   // a b, written out: std::complex's operator* tests every product for inf/NaN.
   static Complex times(Complex a, Complex b) {
@@ -430,7 +504,9 @@ class KleinGordon final : public tsi::Model,
   }
 
   tsi::SpectralGrid grid_;
-  Index n_x_;       // the grid's points, N
+  tsi::GridSlab slab_;            // the points held here: the whole grid but in a split run
+  const tsi::Collective* split_;  // the processes of tsi run --split, or null
+  Index n_x_;                     // the points held here (N on one process)
   std::optional<tsi::PlaneWave> wave_;
   std::optional<FieldAndMomentum> data_;  // model.z0 and model.eps_z_t0
   Real lambda_;
@@ -553,7 +629,7 @@ void register_klein_gordon(tsi::Registry& registry) {
     std::optional<FieldAndMomentum> data = field_and_momentum(p, shape);
     const std::optional<tsi::PlaneWave> wave = tsi::plane_wave(p, shape);
     return std::make_unique<KleinGordon>(p.number("eps"), std::move(shape), p.number("lambda"), wave, std::move(data),
-                                         p.context().fft);
+                                         p.context().fft, p.context().collective);
   };
   registry.add_model(std::move(entry));
 }
