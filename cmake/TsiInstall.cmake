@@ -2,6 +2,7 @@
 #   P/bin/tsi                    the runner (finds P/lib/tsi/plugins relative to itself)
 #   P/lib/libtsi_core.so*        the core library
 #   P/lib/tsi/plugins/tsi_*.so   the shipped plugins (tsi_add_plugin installs them)
+#   P/lib/tsi/libtsi_hdf5_fields.so  output.fields_every's HDF5 writer (apps/tsi/CMakeLists.txt)
 #   P/include/tsi/*.hpp          the public headers: everything a plugin needs
 #   P/lib/cmake/tsi/             the CMake package: find_package(tsi CONFIG), tsi::core,
 #                                tsi::tsi (the runner) and tsi_add_plugin()

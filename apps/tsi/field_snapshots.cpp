@@ -1,5 +1,6 @@
 #include "field_snapshots.hpp"
 
+#include <dlfcn.h>
 #include <fmt/format.h>
 
 #include <cmath>
@@ -8,10 +9,7 @@
 
 #include "tsi/error.hpp"
 #include "tsi/output.hpp"
-
-#ifdef TSI_WITH_HDF5
-#include <hdf5.h>
-#endif
+#include "tsi/plugin_loader.hpp"
 
 namespace tsi::app {
 
@@ -37,90 +35,87 @@ std::vector<Component> components(bool complex) {
 }
 }  // namespace
 
-#ifdef TSI_WITH_HDF5
 namespace {
-// An HDF5 call that failed: its message names the file and what was being written.
-void check(herr_t status, const std::string& what) {
-  if (status < 0) throw IoError(fmt::format("cannot write {}: {}", h5_name, what));
-}
-hid_t checked(hid_t id, const std::string& what) {
-  if (id < 0) throw IoError(fmt::format("cannot write {}: {}", h5_name, what));
-  return id;
-}
-void attribute(hid_t where, const char* name, hid_t type, const void* value, hsize_t count = 1) {
-  const hid_t space = checked(H5Screate_simple(1, &count, nullptr), name);
-  const hid_t a = checked(H5Acreate2(where, name, type, space, H5P_DEFAULT, H5P_DEFAULT), name);
-  check(H5Awrite(a, type, value), name);
-  H5Aclose(a);
-  H5Sclose(space);
+// The HDF5 module (apps/tsi/hdf5_fields), next to the plugins' directory: lib/tsi/ of the build
+// tree or of an installed prefix. Opened on first use and kept; null where it is not there.
+struct Hdf5Module {
+  void* (*create)(const char*, int, const long long*, const double*) = nullptr;
+  int (*write)(void*, long long, double, int, const char* const*, const double* const*) = nullptr;
+  void (*close)(void*) = nullptr;
+  std::string path, error;
+};
+const Hdf5Module& hdf5_module() {
+  static const Hdf5Module module = [] {
+    Hdf5Module m;
+    m.path = (std::filesystem::path(PluginLoader::default_directory()).parent_path() / "libtsi_hdf5_fields.so").string();
+    void* handle = dlopen(m.path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!handle) {
+      const char* why = dlerror();
+      m.error = why ? why : "not found";
+      return m;
+    }
+    m.create = reinterpret_cast<decltype(m.create)>(dlsym(handle, "tsi_fields_h5_create"));
+    m.write = reinterpret_cast<decltype(m.write)>(dlsym(handle, "tsi_fields_h5_write"));
+    m.close = reinterpret_cast<decltype(m.close)>(dlsym(handle, "tsi_fields_h5_close"));
+    if (!m.create || !m.write || !m.close) m.error = "it lacks the tsi_fields_h5_* functions";
+    return m;
+  }();
+  return module;
 }
 }  // namespace
 
-bool FieldSnapshots::available() { return true; }
+bool FieldSnapshots::available() { return hdf5_module().error.empty(); }
+
+std::string FieldSnapshots::unavailable_reason() {
+  const Hdf5Module& m = hdf5_module();
+  return m.error.empty() ? std::string() : m.path + ": " + m.error;
+}
 
 FieldSnapshots::FieldSnapshots(const std::string& dir, GridFields fields, bool complex)
     : dir_(dir), fields_(std::move(fields)), complex_(complex) {
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // failures are reported as IoError, not printed
+  const Hdf5Module& m = hdf5_module();
+  if (!m.error.empty())
+    throw ConfigError("output.fields_every", "this tsi cannot write HDF5 (" + unavailable_reason() +
+                                                 "); build it with libhdf5-dev installed");
   const std::string path = dir_ + "/" + h5_name;
-  file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-  if (file_ < 0) throw IoError(fmt::format("cannot create {}", path));
-  const hid_t root = static_cast<hid_t>(file_);
-  std::vector<long long> shape(fields_.shape.begin(), fields_.shape.end());
-  attribute(root, "grid_shape", H5T_NATIVE_LLONG, shape.data(), shape.size());
-  attribute(root, "box_lengths", H5T_NATIVE_DOUBLE, fields_.lengths.data(), fields_.lengths.size());
-  const hid_t group = checked(H5Gcreate2(root, "/fields", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "/fields");
-  H5Gclose(group);
-  check(H5Fflush(root, H5F_SCOPE_GLOBAL), "the header");
+  const std::vector<long long> shape(fields_.shape.begin(), fields_.shape.end());
+  file_ = m.create(path.c_str(), static_cast<int>(shape.size()), shape.data(), fields_.lengths.data());
+  if (!file_) throw IoError(fmt::format("cannot create {}", path));
   write_xdmf();
 }
 
 FieldSnapshots::~FieldSnapshots() {
-  if (file_ >= 0) H5Fclose(static_cast<hid_t>(file_));
+  if (file_) hdf5_module().close(file_);
 }
 
 void FieldSnapshots::write(long step, double t, const Vector& x) {
-  const std::size_t rank = fields_.shape.size();
   Index points = 1;
   for (const Index n : fields_.shape) points *= n;
   if (x.size() != points * static_cast<Index>(fields_.names.size()))
     throw Error(fmt::format("output.fields_every: a state of {} values for {} fields of {} points", x.size(),
                             fields_.names.size(), points));
-  const hid_t root = static_cast<hid_t>(file_);
-  const std::string name = group_name(step);
-  const hid_t group = checked(H5Gcreate2(root, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), name);
-  attribute(group, "time", H5T_NATIVE_DOUBLE, &t);
-  const long long step_value = step;
-  attribute(group, "step", H5T_NATIVE_LLONG, &step_value);
-  std::vector<hsize_t> dims(fields_.shape.begin(), fields_.shape.end());
-  const hid_t space = checked(H5Screate_simple(static_cast<int>(rank), dims.data(), nullptr), name);
-  std::vector<double> values(static_cast<std::size_t>(points));
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> arrays;
   for (std::size_t f = 0; f < fields_.names.size(); ++f) {
     const auto field = x.segment(static_cast<Index>(f) * points, points);
     for (const Component& c : components(complex_)) {
+      names.push_back(fields_.names[f] + c.suffix);
+      std::vector<double>& values = arrays.emplace_back(static_cast<std::size_t>(points));
       for (Index p = 0; p < points; ++p) values[static_cast<std::size_t>(p)] = to_double(c.of(field(p)));
-      const std::string dataset = fields_.names[f] + c.suffix;
-      const hid_t d = checked(H5Dcreate2(group, dataset.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT,
-                                         H5P_DEFAULT),
-                              name + "/" + dataset);
-      check(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), name + "/" + dataset);
-      H5Dclose(d);
     }
   }
-  H5Sclose(space);
-  H5Gclose(group);
-  check(H5Fflush(root, H5F_SCOPE_GLOBAL), name);  // on disk before the XDMF file names it
+  std::vector<const char*> name_pointers;
+  std::vector<const double*> array_pointers;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    name_pointers.push_back(names[i].c_str());
+    array_pointers.push_back(arrays[i].data());
+  }
+  if (hdf5_module().write(file_, step, t, static_cast<int>(names.size()), name_pointers.data(),
+                          array_pointers.data()) != 0)
+    throw IoError(fmt::format("cannot write {} of step {} to {}/{}", group_name(step), step, dir_, h5_name));
   written_.push_back({step, t});
   write_xdmf();
 }
-#else
-bool FieldSnapshots::available() { return false; }
-FieldSnapshots::FieldSnapshots(const std::string&, GridFields, bool) {
-  throw ConfigError("output.fields_every", "this tsi was built without HDF5; install libhdf5-dev and rebuild (cmake "
-                                           "finds it by itself) to write field snapshots");
-}
-FieldSnapshots::~FieldSnapshots() = default;
-void FieldSnapshots::write(long, double, const Vector&) {}
-#endif
 
 // XDMF 3: a temporal collection of uniform grids on a CoRectMesh (origin 0, spacing L_i / n_i),
 // dimensions in C order (the slowest first), as the HDF5 arrays are. A 1-D grid is a 2-D mesh of

@@ -643,9 +643,9 @@ RunPlan plan_run(const Json& config, const Registry& registry, const RunSettings
                                     "grid model (nls, klein-gordon, klein-gordon-complex)",
                                     every, assembly.model_entry->info.name));
     if (!FieldSnapshots::available())
-      throw ConfigError("output.fields_every", fmt::format("got {}, but this tsi was built without HDF5; install "
-                                                           "libhdf5-dev and rebuild (cmake finds it by itself)",
-                                                           every));
+      throw ConfigError("output.fields_every", fmt::format("got {}, but this tsi cannot write HDF5 ({}); build it "
+                                                           "with libhdf5-dev installed (cmake finds it by itself)",
+                                                           every, FieldSnapshots::unavailable_reason()));
   }
   const int data_needed = assembly.traits.data_order_for(assembly.model_entry->linear_remainder);
   if (rconf.contains("initial_data_order") && rconf["initial_data_order"].get<int>() < data_needed) {
