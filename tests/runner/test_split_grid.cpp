@@ -65,26 +65,64 @@ print('fields agree to', worst)
   CHECK(r.exit_code == 0);
 }
 
+struct Case {
+  std::string label;
+  t::Json config;
+  int fields;  // the model's grid fields (klein-gordon-complex: u and v)
+};
+
+// The case run on one process, then split over each of `ranks`: u, every row of invariants.csv,
+// the fixed-point sweeps and the field snapshots agree to 1e-12.
+void check_split_matches(const Case& c, const std::vector<int>& ranks) {
+  CAPTURE(c.label);
+  t::TempDir dir("tsi-split-grid");
+  const std::string config = t::write_config(dir, c.config, "run.json");
+  const t::CommandResult one = t::run_tsi({"run", config, "--out", dir / "one"});
+  REQUIRE_MESSAGE(one.exit_code == 0, one.describe());
+  const t::Json one_record = t::read_json(dir.path() / "one/result.json");
+  for (const int p : ranks) {
+    CAPTURE(p);
+    const std::string out = dir / ("split" + std::to_string(p));
+    const t::CommandResult split = t::split_run(p, {config, "--out", out});
+    REQUIRE_MESSAGE(split.exit_code == 0, split.describe());
+    const t::Json record = t::read_json(t::fs::path(out) / "result.json");
+    CHECK(record["split"]["processes"] == p);
+    CHECK(record["fields"]["snapshots"] == 3);  // steps 0, 5 and 10
+    CHECK(t::relative_difference(dir.path() / "one/u_final.npy", t::fs::path(out) / "u_final.npy") < 1e-12);
+    const auto rows = t::csv_rows(dir.path() / "one/invariants.csv"),
+               split_rows = t::csv_rows(t::fs::path(out) / "invariants.csv");
+    REQUIRE(rows.size() == 11);
+    REQUIRE(rows.size() == split_rows.size());
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      for (std::size_t j = 0; j < rows[i].size(); ++j)
+        CHECK(std::abs(split_rows[i][j] - rows[i][j]) <= 1e-12 * std::abs(rows[i][j]) + 1e-13);
+    CHECK(record["solver"] == one_record["solver"]);
+    check_fields(dir.path() / "one", out, c.fields);
+  }
+}
+
+const t::Json nls2 = {{"name", "nls"}, {"dims", 2}, {"n_x", 12}, {"n_y", 8}, {"eps", 0.05}};
+const t::Json kg2 = {{"name", "klein-gordon-complex"}, {"dims", 2}, {"n_x", 12}, {"n_y", 8}, {"eps", 0.05},
+                     {"data", "cai-zhou"}};
+
 }  // namespace
 
+TEST_CASE("split grid run: nls and klein-gordon-complex in 2-D with SE1 on 2 ranks give one rank's run to 1e-12") {
+  for (const Case& c : {Case{"nls 2-D se1", grid_config(nls2, "two-scale", "se1"), 1},
+                        Case{"kg 2-D se1", grid_config(kg2, "two-scale", "se1"), 2}})
+    check_split_matches(c, {2});
+}
+
 TEST_CASE("split grid run: nls and klein-gordon, real and complex, in 2-D and 3-D on 2 and 3 ranks give one rank's run to 1e-12") {
-  const t::Json nls2 = {{"name", "nls"}, {"dims", 2}, {"n_x", 12}, {"n_y", 8}, {"eps", 0.05}};
   const t::Json nls3 = {{"name", "nls"}, {"dims", 3}, {"n_x", 6}, {"n_y", 4}, {"n_z", 4}, {"eps", 0.1}};
-  const t::Json kg2 = {{"name", "klein-gordon-complex"}, {"dims", 2}, {"n_x", 12}, {"n_y", 8}, {"eps", 0.05},
-                       {"data", "cai-zhou"}};
   const t::Json kg3 = {{"name", "klein-gordon-complex"}, {"dims", 3}, {"n_x", 6}, {"n_y", 4}, {"n_z", 4},
                        {"eps", 0.1}, {"data", "cai-zhou"}};
   const t::Json real2 = {{"name", "klein-gordon"}, {"dims", 2}, {"n_x", 12}, {"n_y", 8}, {"eps", 0.05}};
   const t::Json real3 = {{"name", "klein-gordon"}, {"dims", 3}, {"n_x", 6}, {"n_y", 4}, {"n_z", 4}, {"eps", 0.1}};
-  struct Case {
-    std::string label;
-    t::Json config;
-    int fields;
-  };
   // Not here: eab and fd on the two-scale problem of either Klein-Gordon. Their prepared data of
   // order 6 (4 for fd) amplify the transforms' rounding about 10^7-fold, so that two FFT plans of
   // one process differ by 4e-11 (real, 2-D) to 1.4e-9 (complex, 3-D): the one-process run against
-  // `mpirun -np 1 --split`. docs/benchmarks/scaling.md.
+  // `mpirun -np 1 --split`. docs/how-to/mpi-and-shards.md.
   t::Json anderson = grid_config(nls2, "two-scale", "composition");  // the base scheme's fixed points, reduced
   anderson["scheme"]["solver"] = "anderson";
   for (const Case& c : {Case{"nls 2-D se1", grid_config(nls2, "two-scale", "se1"), 1},
@@ -96,33 +134,8 @@ TEST_CASE("split grid run: nls and klein-gordon, real and complex, in 2-D and 3-
                         Case{"kg 3-D npi, filtered", grid_config(kg3, "filtered", "npi"), 2},
                         Case{"kg 2-D trigonometric, direct", grid_config(kg2, "direct", "trigonometric"), 2},
                         Case{"real kg 2-D se2", grid_config(real2, "two-scale", "se2"), 1},
-                        Case{"real kg 3-D micro-macro, filtered", grid_config(real3, "filtered", "micro-macro"), 1}}) {
-    CAPTURE(c.label);
-    t::TempDir dir("tsi-split-grid");
-    const std::string config = t::write_config(dir, c.config, "run.json");
-    const t::CommandResult one = t::run_tsi({"run", config, "--out", dir / "one"});
-    REQUIRE_MESSAGE(one.exit_code == 0, one.describe());
-    const t::Json one_record = t::read_json(dir.path() / "one/result.json");
-    for (const int ranks : {2, 3}) {
-      CAPTURE(ranks);
-      const std::string out = dir / ("split" + std::to_string(ranks));
-      const t::CommandResult split = t::split_run(ranks, {config, "--out", out});
-      REQUIRE_MESSAGE(split.exit_code == 0, split.describe());
-      const t::Json record = t::read_json(t::fs::path(out) / "result.json");
-      CHECK(record["split"]["processes"] == ranks);
-      CHECK(record["fields"]["snapshots"] == 3);  // steps 0, 5 and 10
-      CHECK(t::relative_difference(dir.path() / "one/u_final.npy", t::fs::path(out) / "u_final.npy") < 1e-12);
-      const auto rows = t::csv_rows(dir.path() / "one/invariants.csv"),
-                 split_rows = t::csv_rows(t::fs::path(out) / "invariants.csv");
-      REQUIRE(rows.size() == 11);
-      REQUIRE(rows.size() == split_rows.size());
-      for (std::size_t i = 0; i < rows.size(); ++i)
-        for (std::size_t j = 0; j < rows[i].size(); ++j)
-          CHECK(std::abs(split_rows[i][j] - rows[i][j]) <= 1e-12 * std::abs(rows[i][j]) + 1e-13);
-      CHECK(record["solver"] == one_record["solver"]);
-      check_fields(dir.path() / "one", out, c.fields);
-    }
-  }
+                        Case{"real kg 3-D micro-macro, filtered", grid_config(real3, "filtered", "micro-macro"), 1}})
+    check_split_matches(c, {2, 3});
 }
 
 TEST_CASE("split grid run: a grid that cannot be split in slabs is refused on every rank, naming the field") {
