@@ -146,8 +146,8 @@ int main(int argc, char** argv) {
   bool split = false;
   run->add_flag("--split", split,
                 "split the run's state over MPI ranks: mpirun -np P tsi run CONFIG --split (vlasov-poisson-2d's "
-                "particles; nls, klein-gordon and klein-gordon-complex in 2-D and 3-D: slabs of the grid, n_x a "
-                "multiple of P; one thread per rank unless --threads; rank 0 writes the files)");
+                "particles; nls, klein-gordon and klein-gordon-complex in 2-D and 3-D: slabs of the grid, n_x and "
+                "n_y multiples of P; one thread per rank unless --threads; rank 0 writes the files)");
 
   auto* study = app.add_subcommand("study", "run a study (a base config and lists of values) in parallel");
   std::string study_path, study_out;

@@ -42,34 +42,42 @@ const MPI_Datatype mpi_real = std::is_same_v<Real, double> ? MPI_DOUBLE : MPI_LO
 #endif
 
 // The slab transforms of a split run (Collective::slab_transforms): one FFTW MPI plan each
-// way for one field, its first direction in equal blocks of rows (grid_slab's), input and
-// output in the same layout (no FFTW_MPI_TRANSPOSED_OUT: the state's slab is the same in both
-// spaces, so the linear flow and the cubic term stay local). The columns go through the plans
-// one at a time, via FFTW's own buffer, which holds the transposes' room too. Planned with
-// FFTW_MEASURE: on 64^3 over 2 ranks a step takes 0.158 s against FFTW_ESTIMATE's 0.217 s, and
-// the planning fits in the first step (docs/benchmarks/scaling.md). Measured plans may differ
-// from run to run, and so may a split run's last bits (the answer is one rank's to 1e-12).
+// way for one field. On the grid, equal blocks of the first direction (grid_slab's rows); in
+// Fourier space, equal blocks of the second, transposed (FFTW_MPI_TRANSPOSED_OUT forward,
+// FFTW_MPI_TRANSPOSED_IN back): a transform makes one all-to-all instead of the two that
+// keeping the first direction's blocks in both spaces takes. The linear flow and the cubic term
+// stay local either way. The columns go through the plans one at a time, via FFTW's own buffer,
+// which holds the transposes' room too. Planned with FFTW_MEASURE. On 64^3 over 2 ranks a step
+// took 0.217 s with estimated plans of the untransposed layout, 0.158 s measured, 0.146 s
+// measured and transposed (docs/benchmarks/scaling.md). Measured plans may differ from run to
+// run, and so may a split run's last bits (the answer is one rank's to 1e-12).
 class MpiSlabTransforms final : public FieldTransforms {
  public:
-  MpiSlabTransforms(const SpectralGrid& grid, Index columns, int processes) : columns_(columns) {
-    const GridSlab slab = grid_slab_for(grid, processes);
+  MpiSlabTransforms(const SpectralGrid& grid, Index columns, const GridSlab& slab, int processes)
+      : points_(slab.points()), columns_(columns) {
     std::vector<ptrdiff_t> n(grid.shape().begin(), grid.shape().end());
-    ptrdiff_t local_rows = 0, first_row = 0;
-    const ptrdiff_t room = TSI_FFTW_MPI(local_size_many)(grid.dims(), n.data(), 1, static_cast<ptrdiff_t>(slab.rows),
-                                                         MPI_COMM_WORLD, &local_rows, &first_row);
-    points_ = slab.points();
+    ptrdiff_t local_rows = 0, first_row = 0, local_columns = 0, first_column = 0;
+    const auto block = static_cast<ptrdiff_t>(slab.rows), tblock = static_cast<ptrdiff_t>(slab.columns);
+    const ptrdiff_t room = TSI_FFTW_MPI(local_size_many_transposed)(grid.dims(), n.data(), 1, block, tblock,
+                                                                    MPI_COMM_WORLD, &local_rows, &first_row,
+                                                                    &local_columns, &first_column);
     buffer_ = reinterpret_cast<Complex*>(TSI_FFTW_PLAIN(alloc_complex)(static_cast<size_t>(std::max<ptrdiff_t>(room, 1))));
     if (!buffer_) throw Error(fmt::format("--split: cannot allocate the slab transforms' {} values", room));
     auto* data = reinterpret_cast<TSI_FFTW_PLAIN(complex)*>(buffer_);
-    const int signs[2] = {FFTW_FORWARD, FFTW_BACKWARD};
-    for (int d = 0; d < 2; ++d)
-      plans_[d] = TSI_FFTW_MPI(plan_many_dft)(grid.dims(), n.data(), 1, static_cast<ptrdiff_t>(slab.rows),
-                                              FFTW_MPI_DEFAULT_BLOCK, data, data, MPI_COMM_WORLD, signs[d],
-                                              FFTW_MEASURE);
-    if (!plans_[0] || !plans_[1] || local_rows != slab.rows) {
+    plans_[0] = TSI_FFTW_MPI(plan_many_dft)(grid.dims(), n.data(), 1, block, tblock, data, data, MPI_COMM_WORLD,
+                                            FFTW_FORWARD, FFTW_MEASURE | FFTW_MPI_TRANSPOSED_OUT);
+    // Back from the transposed layout: its input's blocks are the second direction's (FFTW's
+    // `block` is the input's first dimension, `tblock` the output's).
+    plans_[1] = TSI_FFTW_MPI(plan_many_dft)(grid.dims(), n.data(), 1, tblock, block, data, data, MPI_COMM_WORLD,
+                                            FFTW_BACKWARD, FFTW_MEASURE | FFTW_MPI_TRANSPOSED_IN);
+    const bool planned = plans_[0] && plans_[1];
+    if (!planned || local_rows != block || local_columns != tblock ||
+        first_row != static_cast<ptrdiff_t>(slab.first_row) || first_column != static_cast<ptrdiff_t>(slab.first_column)) {
       release();
-      throw Error(fmt::format("--split: FFTW could not plan the slab transforms of the grid {} over {} processes",
-                              grid.describe(), processes));
+      throw Error(fmt::format("--split: FFTW could not plan the slab transforms of the grid {} over {} processes "
+                              "({}; rows {} from {}, columns {} from {}, expected {} from {} and {} from {})",
+                              grid.describe(), processes, planned ? "planned" : "no plan", local_rows, first_row,
+                              local_columns, first_column, block, slab.first_row, tblock, slab.first_column));
     }
     data_.resize(points_, columns_);
     data_.setZero();
@@ -84,10 +92,6 @@ class MpiSlabTransforms final : public FieldTransforms {
   Index columns() const override { return columns_; }
 
  private:
-  static GridSlab grid_slab_for(const SpectralGrid& grid, int processes) {
-    const Index rows = grid.shape().front() / processes;
-    return {0, rows, grid.points() / grid.shape().front()};
-  }
   void execute(int direction) {
     for (Index j = 0; j < columns_; ++j) {
       std::copy_n(data_.col(j).data(), points_, buffer_);
@@ -101,7 +105,7 @@ class MpiSlabTransforms final : public FieldTransforms {
     if (buffer_) TSI_FFTW_PLAIN(free)(buffer_), buffer_ = nullptr;
   }
 
-  Index points_ = 0, columns_;
+  Index points_, columns_;
   Complex* buffer_ = nullptr;
   void* plans_[2] = {nullptr, nullptr};  // forward, backward
   Matrix data_;
@@ -146,8 +150,7 @@ class MpiWorld final : public Collective {
   }
 #if !defined(TSI_PRECISION_QUAD)
   std::unique_ptr<FieldTransforms> slab_transforms(const SpectralGrid& grid, Index columns) const override {
-    grid_slab(grid, this);  // the checks, naming the grid's fields
-    return std::make_unique<MpiSlabTransforms>(grid, columns, size_);
+    return std::make_unique<MpiSlabTransforms>(grid, columns, grid_slab(grid, this), size_);
   }
 #endif
   [[noreturn]] void abort(int code) const override {

@@ -250,9 +250,27 @@ GridSlab grid_slab(const SpectralGrid& grid, const Collective* split) {
                                                "the slabs are equal (n_x / processes indices of the first "
                                                "direction each)",
                                                rows, processes, processes));
+  const Index columns = grid.shape()[1];
+  if (columns < processes || columns % processes != 0)
+    throw ConfigError("model.n_y", fmt::format("got {} with --split over {} processes; expected a multiple of {}: "
+                                               "in Fourier space each process holds n_y / processes indices of "
+                                               "the second direction",
+                                               columns, processes, processes));
   slab.rows = rows / processes;
   slab.first_row = slab.rows * split->rank();
+  slab.transposed = true;
+  slab.columns = columns / processes;
+  slab.first_column = slab.columns * split->rank();
+  slab.n1 = rows;
+  slab.n2 = columns;
+  slab.n3 = grid.dims() == 3 ? grid.shape()[2] : 1;
   return slab;
+}
+
+RealVector fourier_slab(const RealVector& whole, const GridSlab& slab) {
+  RealVector mine(slab.points());
+  for (Index q = 0; q < slab.points(); ++q) mine(q) = whole(slab.fourier_point(q));
+  return mine;
 }
 
 std::unique_ptr<FieldTransforms> Collective::slab_transforms(const SpectralGrid& grid, Index /*columns*/) const {

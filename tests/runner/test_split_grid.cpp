@@ -101,8 +101,8 @@ void check_split_matches(const Case& c, const std::vector<int>& ranks) {
   }
 }
 
-const t::Json nls2 = {{"name", "nls"}, {"dims", 2}, {"n_x", 12}, {"n_y", 8}, {"eps", 0.05}};
-const t::Json kg2 = {{"name", "klein-gordon-complex"}, {"dims", 2}, {"n_x", 12}, {"n_y", 8}, {"eps", 0.05},
+const t::Json nls2 = {{"name", "nls"}, {"dims", 2}, {"n_x", 12}, {"n_y", 6}, {"eps", 0.05}};
+const t::Json kg2 = {{"name", "klein-gordon-complex"}, {"dims", 2}, {"n_x", 12}, {"n_y", 6}, {"eps", 0.05},
                      {"data", "cai-zhou"}};
 
 }  // namespace
@@ -114,15 +114,15 @@ TEST_CASE("split grid run: nls and klein-gordon-complex in 2-D with SE1 on 2 ran
 }
 
 TEST_CASE("split grid run: nls and klein-gordon, real and complex, in 2-D and 3-D on 2 and 3 ranks give one rank's run to 1e-12") {
-  const t::Json nls3 = {{"name", "nls"}, {"dims", 3}, {"n_x", 6}, {"n_y", 4}, {"n_z", 4}, {"eps", 0.1}};
-  const t::Json kg3 = {{"name", "klein-gordon-complex"}, {"dims", 3}, {"n_x", 6}, {"n_y", 4}, {"n_z", 4},
+  const t::Json nls3 = {{"name", "nls"}, {"dims", 3}, {"n_x", 6}, {"n_y", 6}, {"n_z", 4}, {"eps", 0.1}};
+  const t::Json kg3 = {{"name", "klein-gordon-complex"}, {"dims", 3}, {"n_x", 6}, {"n_y", 6}, {"n_z", 4},
                        {"eps", 0.1}, {"data", "cai-zhou"}};
-  const t::Json real2 = {{"name", "klein-gordon"}, {"dims", 2}, {"n_x", 12}, {"n_y", 8}, {"eps", 0.05}};
-  const t::Json real3 = {{"name", "klein-gordon"}, {"dims", 3}, {"n_x", 6}, {"n_y", 4}, {"n_z", 4}, {"eps", 0.1}};
+  const t::Json real2 = {{"name", "klein-gordon"}, {"dims", 2}, {"n_x", 12}, {"n_y", 6}, {"eps", 0.05}};
+  const t::Json real3 = {{"name", "klein-gordon"}, {"dims", 3}, {"n_x", 6}, {"n_y", 6}, {"n_z", 4}, {"eps", 0.1}};
   // Not here: eab and fd on the two-scale problem of either Klein-Gordon. Their prepared data of
   // order 6 (4 for fd) amplify the transforms' rounding about 10^7-fold, so that two FFT plans of
-  // one process differ by 4e-11 (real, 2-D) to 1.4e-9 (complex, 3-D): the one-process run against
-  // `mpirun -np 1 --split`. docs/how-to/mpi-and-shards.md.
+  // one process differ by 1e-11 to 1.4e-9 (the one-process run against `mpirun -np 1 --split`):
+  // docs/how-to/mpi-and-shards.md.
   t::Json anderson = grid_config(nls2, "two-scale", "composition");  // the base scheme's fixed points, reduced
   anderson["scheme"]["solver"] = "anderson";
   for (const Case& c : {Case{"nls 2-D se1", grid_config(nls2, "two-scale", "se1"), 1},
@@ -151,7 +151,8 @@ TEST_CASE("split grid run: a grid that cannot be split in slabs is refused on ev
   };
   for (const Case& c : {Case{line, {}, "model.dims: got 1 with --split over 3 processes; expected 2 or 3"},
                         Case{config, {"model.n_x=2"}, "model.n_x: got 2 with --split over 3 processes; expected at least one slab"},
-                        Case{config, {}, "model.n_x: got 8 with --split over 3 processes; expected a multiple of 3"}}) {
+                        Case{config, {}, "model.n_x: got 8 with --split over 3 processes; expected a multiple of 3"},
+                        Case{config, {"model.n_x=6"}, "model.n_y: got 8 with --split over 3 processes; expected a multiple of 3"}}) {
     CAPTURE(c.says);
     std::vector<std::string> args = {c.config, "--out", dir / "out"};
     for (const std::string& s : c.set) args.insert(args.end(), {"--set", s});

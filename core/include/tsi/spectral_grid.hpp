@@ -87,20 +87,38 @@ class TSI_API SpectralGrid {
   RealVector laplacian_;
 };
 
-/// The part of a SpectralGrid that one process of a split run holds (tsi run --split): the
-/// indices [first_row, first_row + rows) of the first direction, with every index of the
-/// others, in both spaces (points and Fourier coefficients alike). In C order that is the
-/// contiguous points [first_point(), first_point() + points()). One process holds the whole grid.
+/// The part of a SpectralGrid that one process of a split run holds (tsi run --split).
+///
+/// On the grid (physical space): the indices [first_row, first_row + rows) of the first
+/// direction, with every index of the others; in C order the contiguous points
+/// [first_point(), first_point() + points()). In Fourier space (`transposed`): the indices
+/// [first_column, first_column + columns) of the second direction, stored transposed, the second
+/// direction slowest, then the first, then the third (FFTW_MPI_TRANSPOSED_OUT's layout: a
+/// transform then makes one all-to-all, not two). fourier_point(q) is the whole grid's C-order
+/// index of coefficient q held here. One process holds the whole grid, in C order in both spaces.
 struct TSI_API GridSlab {
   Index first_row = 0, rows = 0, row_points = 0;  ///< row_points: the points of one index of the first direction
+  bool transposed = false;                        ///< Fourier space in the transposed slabs (a split run)
+  Index first_column = 0, columns = 0;            ///< the second direction's indices held in Fourier space
+  Index n1 = 1, n2 = 1, n3 = 1;                   ///< the grid's shape (1 beyond its dims)
   Index first_point() const { return first_row * row_points; }
   Index points() const { return rows * row_points; }
+  /// The whole grid's C-order index of the Fourier coefficient this process holds at q.
+  Index fourier_point(Index q) const {
+    if (!transposed) return first_point() + q;
+    const Index j3 = q % n3, rest = q / n3, j1 = rest % n1, j2 = first_column + rest / n1;
+    return (j1 * n2 + j2) * n3 + j3;
+  }
 };
 /// The slab of `grid` this process holds: the whole grid without `split`, else rank r of P holds
-/// the rows [r n_1 / P, (r + 1) n_1 / P). A ConfigError naming `model.dims` for a 1-D grid
-/// (FFTW's 1-D MPI transforms change the layout between the spaces), `model.n_x` where there are
-/// more processes than rows or n_1 is not a multiple of the processes.
+/// the rows [r n_1 / P, (r + 1) n_1 / P) on the grid and the columns [r n_2 / P, (r + 1) n_2 / P)
+/// in Fourier space. A ConfigError naming `model.dims` for a 1-D grid (FFTW's 1-D MPI transforms
+/// change the layout between the spaces), `model.n_x` or `model.n_y` where there are more
+/// processes than indices or the size is not a multiple of the processes.
 TSI_API GridSlab grid_slab(const SpectralGrid& grid, const Collective* split);
+/// `whole` (a value per point of the whole grid's Fourier coefficients, as the Laplacian's
+/// symbol) at the coefficients `slab` holds, in their order.
+TSI_API RealVector fourier_slab(const RealVector& whole, const GridSlab& slab);
 /// Calls point(index, x) for every point of `slab` in C order, index counted from the slab's first
 /// point and x the point's coordinates (x_1 .. x_d), as SpectralGrid::for_each_point does.
 template <class Point>

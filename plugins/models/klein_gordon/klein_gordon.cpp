@@ -126,7 +126,7 @@ class KleinGordon final : public tsi::Model,
         half_to_full_(split ? std::vector<std::array<Index, 2>>() : grid_.half_to_full()),
         batches_(grid_, fftw_threads, split) {
     for (Index j = 0; j < n_x_; ++j) {
-      const Real k2 = grid_.laplacian_symbol()(slab_.first_point() + j);  // |k|^2, the Nyquist index as +n/2
+      const Real k2 = grid_.laplacian_symbol()(slab_.fourier_point(j));  // |k|^2, the Nyquist index as +n/2
       const Real root = std::sqrt(1.0 + eps * k2);
       inverse_a_(j) = 1.0 / std::sqrt(root);
       remainder_(j) = k2 / (1.0 + root);
@@ -402,7 +402,7 @@ class KleinGordon final : public tsi::Model,
   tsi::RealVector frequencies() const override {
     tsi::RealVector omega(2 * n_x_);
     for (Index j = 0; j < n_x_; ++j)
-      omega(j) = omega(n_x_ + j) = std::sqrt(1.0 + eps() * grid_.laplacian_symbol()(slab_.first_point() + j)) / eps();
+      omega(j) = omega(n_x_ + j) = std::sqrt(1.0 + eps() * grid_.laplacian_symbol()(slab_.fourier_point(j))) / eps();
     return omega;
   }
   // z = Re v and (1 - e^2 lap)^{-1/2} p = -Im v on the grid; p_k = a_k^2 (that)_k.

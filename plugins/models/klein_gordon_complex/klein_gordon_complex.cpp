@@ -84,7 +84,7 @@ class KleinGordonComplex final : public tsi::Model,
         remainder_(2 * n_),
         batches_(grid_, fftw_threads, split) {
     for (Index j = 0; j < n_; ++j) {
-      const Real k2 = grid_.laplacian_symbol()(slab_.first_point() + j) * std::pow(tsi::two_pi / length_, 2);  // (2 pi k / L)^2
+      const Real k2 = grid_.laplacian_symbol()(slab_.fourier_point(j)) * std::pow(tsi::two_pi / length_, 2);  // (2 pi k / L)^2
       const Real root = std::sqrt(1.0 + eps * k2);
       a_(j) = std::sqrt(root);
       inverse_a_(j) = 1.0 / a_(j);

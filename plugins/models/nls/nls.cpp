@@ -115,10 +115,29 @@ class Phases {
       for (Index m = 1; m < phase.size(); ++m) phase(m) = recurrence.next();
     }
   }
-  // use(point, e^{-i |m|^2 tau}) in the grid's order, point counted from the slab's first. In
-  // 1-D the direction's phase itself (no product: the 1-D values of before the grid, to the bit).
+  // use(point, e^{-i |m|^2 tau}) for every coefficient held here, in their order (the grid's C
+  // order on one process; a split run's transposed slab: tsi::GridSlab). In 1-D the direction's
+  // phase itself (no product: the 1-D values of before the grid, to the bit).
   template <class Use>
   void for_each_point(Use&& use) const {
+    if (slab_.transposed) {  // a split run: the second direction slowest, then the first, then the third
+      const auto at = [](const Vector& phase, const std::vector<int>& folded, Index j) {
+        return phase(folded[static_cast<std::size_t>(j)]);
+      };
+      Index q = 0;
+      for (Index c = 0; c < slab_.columns; ++c) {
+        const Complex second = at(per_direction_[1], grid_.folded(1), slab_.first_column + c);
+        for (Index j1 = 0; j1 < slab_.n1; ++j1) {
+          const Complex lead = times(at(per_direction_[0], grid_.folded(0), j1), second);
+          if (grid_.dims() == 2) {
+            use(q++, lead);
+            continue;
+          }
+          for (Index j3 = 0; j3 < slab_.n3; ++j3) use(q++, times(lead, at(per_direction_[2], grid_.folded(2), j3)));
+        }
+      }
+      return;
+    }
     const std::vector<int>& last = grid_.folded(grid_.dims() - 1);
     const Vector& last_phase = per_direction_[static_cast<std::size_t>(grid_.dims() - 1)];
     const Index n_last = static_cast<Index>(last.size());
@@ -164,10 +183,9 @@ class Nls final : public tsi::Model,
         grid_(std::move(shape)),
         slab_(tsi::grid_slab(grid_, split)),
         split_(split),
-        laplacian_(grid_.laplacian_symbol().segment(slab_.first_point(), slab_.points())),
+        laplacian_(tsi::fourier_slab(grid_.laplacian_symbol(), slab_)),
         wave_(wave),
-        dealias_(dealias ? tsi::RealVector(grid_.dealias_mask().segment(slab_.first_point(), slab_.points()))
-                         : tsi::RealVector()),
+        dealias_(dealias ? tsi::fourier_slab(grid_.dealias_mask(), slab_) : tsi::RealVector()),
         volume_(std::pow(tsi::two_pi, grid_.dims())),
         batches_(grid_, fftw_threads, split) {
     batch(1);  // the single-state plans (filtered, direct, invariants)
@@ -385,7 +403,7 @@ class Nls final : public tsi::Model,
     for (int i = direction + 1; i < grid_.dims(); ++i) stride *= grid_.shape()[static_cast<std::size_t>(i)];
     Real p = 0.0;
     for (Index q = 0; q < c.size(); ++q) {
-      const int j = static_cast<int>(((slab_.first_point() + q) / stride) % n);
+      const int j = static_cast<int>((slab_.fourier_point(q) / stride) % n);
       if (2 * j != n) p += grid_.wave_number(direction, j) * std::norm(c(q));
     }
     return summed(p);
