@@ -40,9 +40,9 @@ if(TSI_WITH_MPI AND NOT MPI_CXX_FOUND)
 endif()
 message(STATUS "tsi: MPI studies ${TSI_WITH_MPI}")
 # HDF5 (optional: Debian's libhdf5-dev, serial): output.fields_every writes a grid model's fields
-# as HDF5 with an XDMF sidecar for ParaView (apps/tsi/field_snapshots.cpp). A split run's fields
-# are gathered on rank 0, which writes them: a snapshot is the physical field, n_tau times
-# smaller than the state vectors the ranks share. Without HDF5, output.fields_every is refused.
+# as HDF5 with an XDMF sidecar for ParaView (apps/tsi/field_snapshots.cpp), through a module that
+# only such runs load (apps/tsi/hdf5_fields). A split run's ranks write their rows of a large
+# snapshot in turn. Without HDF5, output.fields_every is refused.
 pkg_check_modules(HDF5 QUIET IMPORTED_TARGET hdf5)
 option(TSI_WITH_HDF5 "Write field snapshots in HDF5 + XDMF (output.fields_every)" ${HDF5_FOUND})
 if(TSI_WITH_HDF5 AND NOT HDF5_FOUND)

@@ -39,9 +39,9 @@ namespace {
 // The HDF5 module (apps/tsi/hdf5_fields), next to the plugins' directory: lib/tsi/ of the build
 // tree or of an installed prefix. Opened on first use and kept; null where it is not there.
 struct Hdf5Module {
-  void* (*create)(const char*, int, const long long*, const double*) = nullptr;
-  int (*write)(void*, long long, double, int, const char* const*, const double* const*) = nullptr;
-  void (*close)(void*) = nullptr;
+  int (*create)(const char*, int, const long long*, const double*) = nullptr;
+  int (*write_rows)(const char*, long long, double, int, const char* const*, const double* const*, long long,
+                    long long, int) = nullptr;
   std::string path, error;
 };
 const Hdf5Module& hdf5_module() {
@@ -55,12 +55,24 @@ const Hdf5Module& hdf5_module() {
       return m;
     }
     m.create = reinterpret_cast<decltype(m.create)>(dlsym(handle, "tsi_fields_h5_create"));
-    m.write = reinterpret_cast<decltype(m.write)>(dlsym(handle, "tsi_fields_h5_write"));
-    m.close = reinterpret_cast<decltype(m.close)>(dlsym(handle, "tsi_fields_h5_close"));
-    if (!m.create || !m.write || !m.close) m.error = "it lacks the tsi_fields_h5_* functions";
+    m.write_rows = reinterpret_cast<decltype(m.write_rows)>(dlsym(handle, "tsi_fields_h5_write_rows"));
+    if (!m.create || !m.write_rows) m.error = "it lacks the tsi_fields_h5_* functions";
     return m;
   }();
   return module;
+}
+
+// Pointers to the names and arrays, for the module's C interface.
+int write_rows(const std::string& path, long step, double t, const std::vector<std::string>& names,
+               const std::vector<std::vector<double>>& values, Index first_row, Index rows, bool create) {
+  std::vector<const char*> name_pointers;
+  std::vector<const double*> value_pointers;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    name_pointers.push_back(names[i].c_str());
+    value_pointers.push_back(values[i].data());
+  }
+  return hdf5_module().write_rows(path.c_str(), step, t, static_cast<int>(names.size()), name_pointers.data(),
+                                  value_pointers.data(), first_row, rows, create ? 1 : 0);
 }
 }  // namespace
 
@@ -71,21 +83,30 @@ std::string FieldSnapshots::unavailable_reason() {
   return m.error.empty() ? std::string() : m.path + ": " + m.error;
 }
 
-FieldSnapshots::FieldSnapshots(const std::string& dir, GridFields fields, bool complex)
-    : dir_(dir), fields_(std::move(fields)), complex_(complex) {
+FieldSnapshots::FieldSnapshots(const std::string& dir, GridFields fields, bool complex, bool lists)
+    : dir_(dir), fields_(std::move(fields)), complex_(complex), lists_(lists) {
   const Hdf5Module& m = hdf5_module();
   if (!m.error.empty())
     throw ConfigError("output.fields_every", "this tsi cannot write HDF5 (" + unavailable_reason() +
                                                  "); build it with libhdf5-dev installed");
+  if (!lists_) return;
   const std::string path = dir_ + "/" + h5_name;
   const std::vector<long long> shape(fields_.shape.begin(), fields_.shape.end());
-  file_ = m.create(path.c_str(), static_cast<int>(shape.size()), shape.data(), fields_.lengths.data());
-  if (!file_) throw IoError(fmt::format("cannot create {}", path));
+  if (m.create(path.c_str(), static_cast<int>(shape.size()), shape.data(), fields_.lengths.data()) != 0)
+    throw IoError(fmt::format("cannot create {}", path));
   write_xdmf();
 }
 
-FieldSnapshots::~FieldSnapshots() {
-  if (file_) hdf5_module().close(file_);
+void FieldSnapshots::arrays(const Vector& x, Index points, std::vector<std::string>& names,
+                            std::vector<std::vector<double>>& values) const {
+  for (std::size_t f = 0; f < fields_.names.size(); ++f) {
+    const auto field = x.segment(static_cast<Index>(f) * points, points);
+    for (const Component& c : components(complex_)) {
+      names.push_back(fields_.names[f] + c.suffix);
+      std::vector<double>& v = values.emplace_back(static_cast<std::size_t>(points));
+      for (Index p = 0; p < points; ++p) v[static_cast<std::size_t>(p)] = to_double(c.of(field(p)));
+    }
+  }
 }
 
 void FieldSnapshots::write(long step, double t, const Vector& x) {
@@ -95,24 +116,32 @@ void FieldSnapshots::write(long step, double t, const Vector& x) {
     throw Error(fmt::format("output.fields_every: a state of {} values for {} fields of {} points", x.size(),
                             fields_.names.size(), points));
   std::vector<std::string> names;
-  std::vector<std::vector<double>> arrays;
-  for (std::size_t f = 0; f < fields_.names.size(); ++f) {
-    const auto field = x.segment(static_cast<Index>(f) * points, points);
-    for (const Component& c : components(complex_)) {
-      names.push_back(fields_.names[f] + c.suffix);
-      std::vector<double>& values = arrays.emplace_back(static_cast<std::size_t>(points));
-      for (Index p = 0; p < points; ++p) values[static_cast<std::size_t>(p)] = to_double(c.of(field(p)));
-    }
-  }
-  std::vector<const char*> name_pointers;
-  std::vector<const double*> array_pointers;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    name_pointers.push_back(names[i].c_str());
-    array_pointers.push_back(arrays[i].data());
-  }
-  if (hdf5_module().write(file_, step, t, static_cast<int>(names.size()), name_pointers.data(),
-                          array_pointers.data()) != 0)
+  std::vector<std::vector<double>> values;
+  arrays(x, points, names, values);
+  if (write_rows(dir_ + "/" + h5_name, step, t, names, values, 0, fields_.shape.front(), true) != 0)
     throw IoError(fmt::format("cannot write {} of step {} to {}/{}", group_name(step), step, dir_, h5_name));
+  written_.push_back({step, t});
+  write_xdmf();
+}
+
+void FieldSnapshots::write_shares(const Collective& split, long step, double t, const Vector& local) {
+  const Index parts = static_cast<Index>(fields_.names.size()), points = local.size() / parts;
+  Index row_points = 1;
+  for (std::size_t i = 1; i < fields_.shape.size(); ++i) row_points *= fields_.shape[i];
+  const Index rows = points / row_points, first_row = rows * split.rank();  // equal slabs (tsi::grid_slab)
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> values;
+  arrays(local, points, names, values);
+  bool ok = true;
+  for (int turn = 0; turn < split.size(); ++turn) {  // serial HDF5: one writer at a time, rank 0 first
+    if (turn == split.rank())
+      ok = write_rows(dir_ + "/" + h5_name, step, t, names, values, first_row, rows, turn == 0) == 0;
+    if (!split.all(ok))
+      throw IoError(fmt::format("cannot write {} of step {} to {}/{} (rank {} of {}, its rows {} to {})",
+                                group_name(step), step, dir_, h5_name, split.rank(), split.size(), first_row,
+                                first_row + rows - 1));
+  }
+  if (!lists_) return;
   written_.push_back({step, t});
   write_xdmf();
 }

@@ -66,8 +66,10 @@ int run_command(tsi::PluginLoader& loader, tsi::Registry& registry, const std::s
   // The progress line: rank 0's only; erased before the summary (and before an error).
   tsi::app::ProgressLine line(writer ? tsi::app::stderr_progress_mode(quiet) : tsi::app::ProgressMode::off);
   tsi::app::StepProgressLine progress(line);
+  tsi::app::RunSettings run_settings = settings;
+  if (split) run_settings.split_dir = out_dir;  // every process writes its share of a large state there
   const tsi::app::RunOutcome outcome =
-      tsi::app::execute_run(config, registry, settings, line.enabled() ? tsi::app::ProgressFn(std::ref(progress)) : nullptr,
+      tsi::app::execute_run(config, registry, run_settings, line.enabled() ? tsi::app::ProgressFn(std::ref(progress)) : nullptr,
                             nullptr, writer ? out_dir : std::string());
   line.finish();
   if (!writer) return outcome.ok ? 0 : 1;  // the same status on every rank: its stops are agreed

@@ -18,6 +18,7 @@
 #include "field_snapshots.hpp"
 #include "interrupt.hpp"
 #include "run_recorder.hpp"
+#include "split_state_file.hpp"
 #include "tsi/assembly.hpp"
 #include "tsi/collective.hpp"
 #include "tsi/device.hpp"
@@ -719,11 +720,25 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
         ordered.segment((f * processes + r) * share, share) = all.segment((r * parts + f) * share, share);
     return ordered;
   };
+  // A grid model's state files above max_inline_state values in a split run: every process
+  // writes its share (write_split_state), none gathers the state. Smaller ones (result.json
+  // holds them), and a particle run's, are gathered on rank 0. Decided alike on every process.
+  const Index grid_parts = static_cast<Index>(model->grid_fields().names.size());
+  const auto written_in_shares = [&](const Vector& local) {
+    return split && grid_parts > 0 && !settings.split_dir.empty() &&
+           split->sum(static_cast<Real>(local.size())) > static_cast<Real>(max_inline_state);
+  };
+  const auto whole_count = [&](const Vector& local) {
+    return static_cast<Index>(std::llround(to_double(split->sum(static_cast<Real>(local.size())))));
+  };
   // output.fields_every: the fields as HDF5 + XDMF (rank 0 of a split run writes what all gather).
   const long fields_every = config.contains("output") ? config["output"].value("fields_every", 0L) : 0L;
+  // Every process of a split run holds one (the others write their rows of large snapshots).
   std::optional<FieldSnapshots> snapshots;
   if (fields_every > 0 && !stream_dir.empty())
     snapshots.emplace(stream_dir, model->grid_fields(), model->is_complex());
+  else if (fields_every > 0 && split && !settings.split_dir.empty())
+    snapshots.emplace(settings.split_dir, model->grid_fields(), model->is_complex(), /*lists=*/false);
   // u between the steps (output.times), from the scheme's states interpolated in t.
   std::unique_ptr<DenseOutput> dense;
   if (std::vector<double> times = checked_output_times(config); !times.empty())
@@ -778,21 +793,33 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
         return false;
       }
       if (progress && progress_clock.tick()) progress({"run", n, n_steps, to_double(t), t_end});
-      if (go_on && fields_every > 0 && (split || snapshots) && (n % fields_every == 0 || n == n_steps)) {
+      if (go_on && fields_every > 0 && snapshots && (n % fields_every == 0 || n == n_steps)) {
         const device::HostView host(state);
-        const Vector x = whole(model->to_physical(reformulation->read_back(state, t)));
-        if (snapshots) snapshots->write(n, to_double(t), x);
+        const Vector local = model->to_physical(reformulation->read_back(state, t));
+        if (written_in_shares(local)) {
+          snapshots->write_shares(*split, n, to_double(t), local);
+        } else {
+          const Vector x = whole(local);
+          if (!stream_dir.empty()) snapshots->write(n, to_double(t), x);
+        }
       }
       if (go_on && state_every > 0 && (split || !stream_dir.empty()) && (n % state_every == 0 || n == n_steps)) {
         // The state as a file a run can start from (written to a temporary file, then renamed),
         // and result.json's checkpoint says at which time it is.
         const device::HostView host(state);
-        Vector x = whole(model->to_physical(reformulation->read_back(state, t)));
+        const Vector local = model->to_physical(reformulation->read_back(state, t));
+        std::vector<std::uint64_t> shape;
+        for (const Index d : model->physical_shape()) shape.push_back(static_cast<std::uint64_t>(d));
+        if (written_in_shares(local)) {
+          write_split_state(*split, settings.split_dir + "/state.npy", local, grid_parts, model->is_complex(), shape);
+        } else {
+          Vector x = whole(local);
+          if (!stream_dir.empty()) {
+            model->canonicalize_physical(x);
+            write_npy(stream_dir + "/state.npy", x, model->is_complex(), shape);
+          }
+        }
         if (!stream_dir.empty()) {
-          model->canonicalize_physical(x);
-          std::vector<std::uint64_t> shape;
-          for (const Index d : model->physical_shape()) shape.push_back(static_cast<std::uint64_t>(d));
-          write_npy(stream_dir + "/state.npy", x, model->is_complex(), shape);
           result["state"] = {{"file", "state.npy"}, {"t", to_double(t)}, {"step", n}};
           checkpoint(n, to_double(t));
         }
@@ -846,9 +873,10 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   result["status"] = status;
   if (!outcome.ok) result["message"] = outcome.message;
   // The final state: this process's share (errors are norms over every process) and the whole
-  // run's for the files (gathered on rank 0 of a split run).
+  // run's for the files (gathered on rank 0 of a split run, or written in shares when large).
   const Vector x_here = model->to_physical(recorder.u_last());
-  const Vector x = whole(x_here);
+  const bool final_in_shares = written_in_shares(x_here);
+  const Vector x = final_in_shares ? Vector() : whole(x_here);
   if (split) result["split"] = {{"processes", split->size()}, {"memory", "rank 0's"}};
   if (snapshots)
     result["fields"] = {{"file", "fields.h5"}, {"xdmf", "fields.xmf"}, {"every", fields_every},
@@ -862,9 +890,19 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   result["t_end"] = t_end;
   result["t_reached"] = recorder.t_reached();
   outcome.complex_state = model->is_complex();
-  outcome.state_shape = state_shape(config, *model, x.size());
-  outcome.u_final = x;
-  result["u_final"] = state_entry(x, outcome.complex_state, outcome.state_shape, u_final_file);
+  outcome.state_shape = state_shape(config, *model, final_in_shares ? whole_count(x_here) : x.size());
+  if (final_in_shares) {
+    write_split_state(*split, settings.split_dir + "/" + u_final_file, x_here, grid_parts, outcome.complex_state,
+                      outcome.state_shape);
+    outcome.u_final_written = whole_count(x_here);
+    outcome.u_final_head = x_here.head(std::min<Index>(4, x_here.size()));  // rank 0's share comes first
+    result["u_final"] = {{"file", u_final_file},
+                         {"dtype", outcome.complex_state ? "complex128" : "float64"},
+                         {"shape", outcome.state_shape}};
+  } else {
+    outcome.u_final = x;
+    result["u_final"] = state_entry(x, outcome.complex_state, outcome.state_shape, u_final_file);
+  }
   if (dense) result["dense_output"] = dense_output_entry(*dense, outcome);
   result["invariants"] = recorder.invariants_json();
   {
@@ -928,8 +966,18 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
     error["reference"]["wall_seconds"] = ref.wall_seconds;
     error["reference"]["estimated_relative_accuracy"] =
         std::isfinite(ref.accuracy) ? Json(ref.accuracy) : Json(nullptr);
-    outcome.reference_u_final = whole(ref.x);
-    error["reference"]["u_final"] = state_entry(ref.x, outcome.complex_state, outcome.state_shape, reference_u_final_file);
+    if (written_in_shares(ref.x)) {
+      write_split_state(*split, settings.split_dir + "/" + reference_u_final_file, ref.x, grid_parts,
+                        outcome.complex_state, outcome.state_shape);
+      outcome.reference_written = whole_count(ref.x);
+      error["reference"]["u_final"] = {{"file", reference_u_final_file},
+                                       {"dtype", outcome.complex_state ? "complex128" : "float64"},
+                                       {"shape", outcome.state_shape}};
+    } else {
+      outcome.reference_u_final = whole(ref.x);
+      error["reference"]["u_final"] =
+          state_entry(ref.x, outcome.complex_state, outcome.state_shape, reference_u_final_file);
+    }
     result["error"] = error;
   }
   if (outcome.ok && config.contains("output") &&

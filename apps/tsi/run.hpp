@@ -25,6 +25,10 @@ struct RunOutcome {
   /// error.reference.u_final), written to u_final.npy and reference_u_final.npy; empty when
   /// the run never started (or its outcome was read back from its files).
   Vector u_final, reference_u_final;
+  /// A split run's large states (write_split_state): written by every process, so not held
+  /// here; the first values of u_final and the counts of values written, for the summary.
+  Vector u_final_head;
+  Index u_final_written = 0, reference_written = 0;
   /// u at output.times (physical variables, one state per time; empty where the run did not
   /// reach it), written to u_times.npy (NaN there).
   std::vector<double> output_times;
@@ -64,6 +68,9 @@ struct RunSettings {
   double max_steps = default_max_steps;  ///< --max-steps
   /// --device: "cpu", or "cuda" (the steps on the GPU: tsi/device.hpp; a build with TSI_WITH_CUDA).
   std::string device = "cpu";
+  /// tsi run --split: the output directory, on every process (each writes its share of a grid
+  /// model's state files of more than max_inline_state values there); empty otherwise.
+  std::string split_dir{};
   /// The settings of these flags: a ConfigError naming the flag for a value out of range
   /// (threads below 1; a step limit outside 1 .. 1e12).
   static RunSettings from_flags(int tau_grid_threads, int fft_threads, double max_steps);

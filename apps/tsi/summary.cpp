@@ -64,6 +64,11 @@ std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
   }
   for (const auto& w : r["warnings"]) s += fmt::format("  warning: {}\n", w.get<std::string>());
   // The answer last, where a user looks for it: u at the end (round-trip digits) and its error.
+  if (outcome.u_final.size() == 0 && outcome.u_final_written > 0) {  // a split run's, written by every process
+    s += fmt::format("  u({}) = {} ... ({} values: {}/{})\n", outcome.ok ? "t_end" : "t_reached",
+                     printed_state(outcome.u_final_head, outcome.complex_state, 4), outcome.u_final_written, out_dir,
+                     u_final_file);
+  }
   if (outcome.u_final.size() > 0) {
     const bool whole = outcome.u_final.size() <= max_printed_values;
     const std::string at = outcome.ok || !r.contains("t_reached")
@@ -93,8 +98,9 @@ std::string run_summary(const RunOutcome& outcome, const std::string& out_dir) {
       s += fmt::format("  estimated error (Richardson): none, {}\n", e.value("message", std::string("failed")));
   }
   s += fmt::format("  written: {0}/result.json, {0}/invariants.csv", out_dir);
-  if (outcome.u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, u_final_file);
-  if (outcome.reference_u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, reference_u_final_file);
+  if (outcome.u_final.size() > 0 || outcome.u_final_written > 0) s += fmt::format(", {}/{}", out_dir, u_final_file);
+  if (outcome.reference_u_final.size() > 0 || outcome.reference_written > 0)
+    s += fmt::format(", {}/{}", out_dir, reference_u_final_file);
   if (!outcome.u_times.empty() && outcome.u_final.size() > 0) s += fmt::format(", {}/{}", out_dir, u_times_file);
   if (r.contains("fields"))
     s += fmt::format(", {0}/fields.h5 and {0}/fields.xmf ({1} snapshots)", out_dir, r["fields"]["snapshots"].get<long>());

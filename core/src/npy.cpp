@@ -362,6 +362,10 @@ std::vector<std::uint64_t> checked_shape(const std::string& path, std::uint64_t 
 
 }  // namespace
 
+std::string npy_header_bytes(bool complex_values, const std::vector<std::uint64_t>& shape) {
+  return npy_header(complex_values ? "<c16" : "<f8", shape);
+}
+
 std::string npy_shape_text(const std::vector<std::uint64_t>& shape) {
   if (shape.size() == 1) return fmt::format("({},)", shape.front());
   return fmt::format("({})", fmt::join(shape, ", "));

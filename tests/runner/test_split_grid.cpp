@@ -138,6 +138,38 @@ TEST_CASE("split grid run: nls and klein-gordon, real and complex, in 2-D and 3-
     check_split_matches(c, {2, 3});
 }
 
+TEST_CASE("split grid run: above 4096 values every rank writes its share of the state files and snapshots, none gathers") {
+  // 2 x 48 x 48 values (u and v): result.json names the files, and the ranks write them.
+  t::Json config = grid_config({{"name", "klein-gordon-complex"}, {"dims", 2}, {"n_x", 48}, {"n_y", 48}, {"eps", 0.05},
+                                {"data", "cai-zhou"}},
+                               "two-scale", "se1");
+  config["reformulation"]["n_tau"] = 8;
+  config["time"] = {{"h", 0.02}, {"t_end", 0.06}};
+  config["output"] = {{"every", 1}, {"fields_every", 2}, {"state_every", 2}};
+  config["reference"] = {{"scheme", "se1"}, {"reformulation", "two-scale"}, {"h", 0.01}, {"n_tau", 8}};
+  t::TempDir dir("tsi-split-shares");
+  const std::string file = t::write_config(dir, config, "run.json");
+  const t::CommandResult one = t::run_tsi({"run", file, "--out", dir / "one"});
+  REQUIRE_MESSAGE(one.exit_code == 0, one.describe());
+  for (const int p : {2, 3}) {
+    CAPTURE(p);
+    const t::fs::path out = dir.path() / ("split" + std::to_string(p));
+    const t::CommandResult split = t::split_run(p, {file, "--out", out.string()});
+    REQUIRE_MESSAGE(split.exit_code == 0, split.describe());
+    CHECK(t::contains(split.out, "(4608 values: "));  // the summary's u, from rank 0's share
+    const t::Json record = t::read_json(out / "result.json");
+    CHECK(record["u_final"] == t::Json({{"file", "u_final.npy"}, {"dtype", "complex128"}, {"shape", {2, 48, 48}}}));
+    for (const char* name : {"u_final.npy", "state.npy", "reference_u_final.npy"}) {
+      CAPTURE(name);
+      CHECK(t::relative_difference(dir.path() / "one" / name, out / name) < 1e-12);
+      CHECK_FALSE(t::fs::exists(out / (std::string(name) + ".split-partial")));
+    }
+    CHECK(record["error"]["relative"].get<double>() ==
+          doctest::Approx(t::read_json(dir.path() / "one/result.json")["error"]["relative"].get<double>()).epsilon(1e-9));
+    check_fields(dir.path() / "one", out, 2);
+  }
+}
+
 TEST_CASE("split grid run: a grid that cannot be split in slabs is refused on every rank, naming the field") {
   t::TempDir dir("tsi-split-grid-refused");
   const t::Json nls2 = {{"name", "nls"}, {"dims", 2}, {"n_x", 8}, {"n_y", 8}, {"eps", 0.1}};

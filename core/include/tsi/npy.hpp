@@ -68,6 +68,11 @@ TSI_API void write_npy(const std::string& path, const Vector& values, bool compl
 TSI_API void write_npy_rows(const std::string& path, const std::vector<Vector>& rows, Index row_size,
                             bool complex_values, const std::vector<std::uint64_t>& shape);
 
+/// The header np.save writes before the values of a float64 (complex_values false) or complex128
+/// array of `shape`: for a file whose values are written by other means (a split run's
+/// processes, each at its offset after it).
+TSI_API std::string npy_header_bytes(bool complex_values, const std::vector<std::uint64_t>& shape);
+
 /// A shape as Python writes a tuple: "()", "(3,)", "(2, 3)".
 TSI_API std::string npy_shape_text(const std::vector<std::uint64_t>& shape);
 
