@@ -302,6 +302,10 @@ Json state_to_json(const Vector& x, bool complex_state) {
 
 Json state_entry(const Vector& x, bool complex_state, const std::vector<std::uint64_t>& shape, const std::string& file) {
   if (x.size() <= max_inline_state) return state_to_json(x, complex_state);
+  return state_file_entry(complex_state, shape, file);
+}
+
+Json state_file_entry(bool complex_state, const std::vector<std::uint64_t>& shape, const std::string& file) {
   return {{"file", file}, {"dtype", complex_state ? "complex128" : "float64"}, {"shape", shape}};
 }
 
@@ -706,8 +710,8 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   // A state of the whole run: a split run's shares gathered on rank 0 (empty elsewhere).
   // A grid model's fields (u, then v) are each split in slabs: rank r's share is its slab of
   // every field, and the whole state each field's slabs in rank order.
-  const auto whole = [split, complex = model->is_complex(),
-                      parts = std::max<Index>(1, static_cast<Index>(model->grid_fields().names.size()))](
+  const Index grid_parts = static_cast<Index>(model->grid_fields().names.size());
+  const auto whole = [split, complex = model->is_complex(), parts = std::max<Index>(1, grid_parts)](
                          const Vector& local) -> Vector {
     if (!split) return local;
     Vector all = split->gather(local.real()).cast<Complex>();
@@ -723,7 +727,6 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   // A grid model's state files above max_inline_state values in a split run: every process
   // writes its share (write_split_state), none gathers the state. Smaller ones (result.json
   // holds them), and a particle run's, are gathered on rank 0. Decided alike on every process.
-  const Index grid_parts = static_cast<Index>(model->grid_fields().names.size());
   const auto written_in_shares = [&](const Vector& local) {
     return split && grid_parts > 0 && !settings.split_dir.empty() &&
            split->sum(static_cast<Real>(local.size())) > static_cast<Real>(max_inline_state);
@@ -890,15 +893,13 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
   result["t_end"] = t_end;
   result["t_reached"] = recorder.t_reached();
   outcome.complex_state = model->is_complex();
-  outcome.state_shape = state_shape(config, *model, final_in_shares ? whole_count(x_here) : x.size());
+  outcome.u_final_written = final_in_shares ? whole_count(x_here) : 0;
+  outcome.state_shape = state_shape(config, *model, final_in_shares ? outcome.u_final_written : x.size());
   if (final_in_shares) {
     write_split_state(*split, settings.split_dir + "/" + u_final_file, x_here, grid_parts, outcome.complex_state,
                       outcome.state_shape);
-    outcome.u_final_written = whole_count(x_here);
     outcome.u_final_head = x_here.head(std::min<Index>(4, x_here.size()));  // rank 0's share comes first
-    result["u_final"] = {{"file", u_final_file},
-                         {"dtype", outcome.complex_state ? "complex128" : "float64"},
-                         {"shape", outcome.state_shape}};
+    result["u_final"] = state_file_entry(outcome.complex_state, outcome.state_shape, u_final_file);
   } else {
     outcome.u_final = x;
     result["u_final"] = state_entry(x, outcome.complex_state, outcome.state_shape, u_final_file);
@@ -970,9 +971,8 @@ RunOutcome execute_run(const Json& config, const Registry& registry, const RunSe
       write_split_state(*split, settings.split_dir + "/" + reference_u_final_file, ref.x, grid_parts,
                         outcome.complex_state, outcome.state_shape);
       outcome.reference_written = whole_count(ref.x);
-      error["reference"]["u_final"] = {{"file", reference_u_final_file},
-                                       {"dtype", outcome.complex_state ? "complex128" : "float64"},
-                                       {"shape", outcome.state_shape}};
+      error["reference"]["u_final"] =
+          state_file_entry(outcome.complex_state, outcome.state_shape, reference_u_final_file);
     } else {
       outcome.reference_u_final = whole(ref.x);
       error["reference"]["u_final"] =

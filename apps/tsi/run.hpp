@@ -158,5 +158,8 @@ Json state_to_json(const Vector& x, bool complex_state);
 /// result.json's entry for a state written to `file`: the state itself (state_to_json) up to
 /// max_inline_state values, else {"file": file, "dtype": "float64" | "complex128", "shape": [...]}.
 Json state_entry(const Vector& x, bool complex_state, const std::vector<std::uint64_t>& shape, const std::string& file);
+/// The entry that names the file alone: {"file": file, "dtype": ..., "shape": shape} (also a split
+/// run's state that its processes wrote in shares, which no process holds whole).
+Json state_file_entry(bool complex_state, const std::vector<std::uint64_t>& shape, const std::string& file);
 
 }  // namespace tsi::app

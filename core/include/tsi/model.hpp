@@ -175,10 +175,11 @@ class TSI_API Model {
 
  protected:
   explicit Model(Real eps);
+  /// A number summed over processes() (itself on one process): a split model's sums of its
+  /// share (H1, its invariants, its error norm) made whole.
+  Real summed(Real local) const;
 
  private:
-  /// A number summed over the processes of a split run (itself on one process).
-  Real summed(Real local) const;
   Real eps_;
 };
 

@@ -495,8 +495,6 @@ class KleinGordon final : public tsi::Model,
   }
   // N, the whole grid's points (the transforms' normalisation).
   Real point_count() const { return static_cast<Real>(grid_.points()); }
-  // A sum over the processes of a split run (itself on one).
-  Real summed(Real local) const { return split_ ? split_->sum(local) : local; }
 
   // a b, written out: std::complex's operator* tests every product for inf/NaN.
   static Complex times(Complex a, Complex b) {

@@ -287,8 +287,6 @@ class KleinGordonComplex final : public tsi::Model,
  private:
   // N, the whole grid's points (the transforms' normalisation).
   Real point_count() const { return static_cast<Real>(grid_.points()); }
-  // A sum over the processes of a split run (itself on one).
-  Real summed(Real local) const { return split_ ? split_->sum(local) : local; }
 
   // c from the samples (u, v): c_u = (2 pi)^{d/2} / N a forward(u). Callers hold mutex_.
   Vector from_samples(const Vector& uv) const {

@@ -523,8 +523,6 @@ class Nls final : public tsi::Model,
   }
 
   Real point_count() const { return static_cast<Real>(grid_.points()); }
-  // A sum over the processes of a split run (itself on one).
-  Real summed(Real local) const { return split_ ? split_->sum(local) : local; }
 
   // With the 2/3 rule, the modes outside its band set to zero (columns of coefficients).
   template <class Columns>
